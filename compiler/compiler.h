@@ -1,0 +1,25 @@
+// The compiler's entry points: from .pcsg text to the cyclic CSG graph.
+// Phases: lexer.cpp (tokens, #define expansion) -> parser.cpp (AST, ast.h) ->
+// builder.cpp (name and arity checks, the Graph of graph.h).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "diagnostics.h"
+#include "graph.h"
+
+namespace pcsg {
+
+// Compiles source text. Returns the graph, or nothing with the errors in `diags`.
+// `text` must outlive `diags` (diagnostics quote source lines).
+std::optional<Graph> compileSource(std::string_view fileName, std::string_view text,
+                                   Diagnostics& diags);
+
+// Reads and compiles a file. An unreadable file is a diagnostic too. The file's text is
+// kept alive by `diags`' owner through `storage`.
+std::optional<Graph> compileFile(const std::string& path, std::string& storage,
+                                 Diagnostics& diags);
+
+}  // namespace pcsg

@@ -1,0 +1,233 @@
+// The cyclic CSG graph: the one representation that the compiler produces and that the
+// tracer and the expander read. See ../docs/DESIGN.md and the seed paper, section 2.2.
+//
+// Everything is stored in flat arrays indexed by small integers, so that a graph is a
+// handful of vectors (its size in bytes is graphBytes()) and the hot loops of the tracer
+// switch over NodeKind without virtual calls.
+//
+//  - One S-node (NodeKind::Select) per module. Its children are the module's rules, in
+//    rule order (rule k is child k-1). Module references in rule bodies are plain edges
+//    to the S-node: the graph is cyclic and S-nodes are the only targets of back edges.
+//  - T-nodes (Transform) have one child and a transformation whose arguments are
+//    expressions over parameter slots.
+//  - C-nodes (Calc) have one child and an ordered list of assignments.
+//  - Paint nodes have one child and a material index.
+//  - Union, Intersection and Difference are n-ary (chains of the same operator are
+//    flattened by the builder: A ∪ B ∪ C is one Union with three children;
+//    A \ B \ C is one Difference: the first child minus all the others).
+//  - Primitive nodes are leaves.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "geometry.h"
+
+namespace pcsg {
+
+using NodeId = uint32_t;
+using ExprId = uint32_t;
+using Slot = uint32_t;
+inline constexpr uint32_t kNone = UINT32_MAX;
+
+// A position in a source file: file index into Graph::files, 1-based line and column
+// (column counts bytes). line 0 means "no position".
+struct FileLoc {
+    uint32_t file = 0;
+    uint32_t line = 0;
+    uint32_t column = 0;
+};
+
+// ---------------------------------------------------------------------------------------
+// Expressions: a flat stack code over parameter slots.
+
+enum class Func : uint8_t {
+    Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Exp, Ln, Log10, Pow, Abs, Floor, Ceil,
+    Min, Max, Mod, Clamp, Rand1,  // rand(x)
+};
+
+enum class Op : uint8_t {
+    Const,       // push imm
+    Load,        // push frame[a]; reading an unassigned slot is a run-time error
+    Neg, Not,    // unary
+    Add, Sub, Mul, Div, Mod, Pow,  // binary: pops b, then a, pushes a op b
+    Lt, Le, Gt, Ge, Eq, Ne,        // comparisons give 1 or 0
+    Jump,        // pc = a (absolute index into Graph::code)
+    JumpIfZero,  // pops v; if v == 0, pc = a
+    ToBool,      // replaces v by (v != 0)
+    Call,        // a = Func, argc = number of arguments popped (min/max take 2 or more)
+    Rand0,       // rand(): push uniform [0,1) from (seed, instance path, call site a)
+    Choose,      // choose(w1..wn): argc = n, call site a; pushes a rule number 1..n
+};
+
+struct Instr {
+    Op op;
+    uint8_t argc = 0;
+    uint32_t a = 0;
+    double imm = 0;
+};
+
+struct Expr {
+    uint32_t begin = 0, end = 0;  // [begin, end) in Graph::code
+    uint32_t maxStack = 0;        // the largest stack depth the code reaches
+    bool constant = false;        // reads no slot and calls no rand()/choose()
+    bool usesPath = false;        // calls rand() or choose(): depends on the instance path
+    FileLoc loc;
+    std::string text;  // the source text, for run-time error messages
+};
+
+// ---------------------------------------------------------------------------------------
+// Nodes.
+
+enum class NodeKind : uint8_t {
+    Select, Transform, Calc, Paint, Union, Intersection, Difference, Primitive,
+};
+
+struct Node {
+    NodeKind kind;
+    uint32_t payload = kNone;  // index into the kind's table (modules, transforms, calcs,
+                               // materials for Paint, primitives); unused for operators
+    uint32_t firstChild = 0;   // children are Graph::edges[firstChild, firstChild+childCount)
+    uint32_t childCount = 0;
+    FileLoc loc;
+};
+
+// One module: the data of its S-node.
+struct Module {
+    std::string name;
+    NodeId node = kNone;  // its S-node
+    FileLoc loc;
+    // Notation A: `NAME expr`; the expression's value rounded to the nearest integer is
+    // the rule number.
+    ExprId select = kNone;
+    // Notation B: the first rule in order whose condition is non-zero is taken; a rule
+    // without condition has kNone here (always true). Empty for notation A.
+    bool notationB = false;
+    std::vector<ExprId> conditions;
+    std::vector<Slot> formals;  // notation B formal parameters, e.g. S(c)
+};
+
+enum class TransformOp : uint8_t {
+    Move,     // args dx dy dz (alias translate)
+    Scale,    // fx fy fz
+    UScale,   // f
+    RotX, RotY, RotZ,  // a (degrees, right-handed)
+    Rot,      // ax ay az a
+    ZShear,   // a b: (x, y, z + a x + b y)
+    FlipYZ, FlipXZ, FlipXY,  // no args: mirror in that coordinate plane (flipxz: y -> -y)
+    Matrix,   // m11 m12 m13 m21 m22 m23 m31 m32 m33 tx ty tz: p·M + t as in POV-Ray
+};
+
+struct Transform {
+    TransformOp op;
+    uint32_t firstArg = 0, argCount = 0;  // Graph::args[firstArg, firstArg+argCount)
+    bool constant = false;                // all arguments constant: `matrix` is valid
+    Affine matrix;                        // precomputed when constant
+};
+
+struct Assignment {
+    Slot slot;
+    ExprId value;
+};
+
+struct Calc {
+    uint32_t first = 0, count = 0;  // Graph::assignments[first, first+count)
+    // false: assignments run in order, each sees the ones before (a C-node `{...}`).
+    // true: all values are computed from the incoming frame, then assigned together
+    //       (a notation-B call S(e1, e2) on formals (c1, c2)).
+    bool simultaneous = false;
+};
+
+enum class PrimitiveKind : uint8_t {
+    Sphere, Cube, Cylinder, Cone, Tetrahedron, Torus, Plane, Empty, Tri1, Tri2, Triangle,
+};
+
+struct Primitive {
+    PrimitiveKind kind;
+    uint32_t firstArg = 0, argCount = 0;  // torus: R r; triangle: 9 coordinates
+    bool constant = true;                 // all arguments constant
+    std::vector<double> values;           // the argument values when constant
+};
+
+// ---------------------------------------------------------------------------------------
+// Scene directives (LANGUAGE.md section 7). All values are constants.
+
+struct Camera {
+    Vec3 location{0, -5, 2};
+    Vec3 lookAt{0, 0, 0};
+    Vec3 sky{0, 0, 1};
+    double angle = 40;  // horizontal field of view, degrees
+};
+
+struct Light {
+    Vec3 position{10, -20, 30};
+    Vec3 color{1, 1, 1};
+};
+
+// POV-Ray 3.7's pigment colour and classic finish, with POV-Ray's defaults.
+struct Material {
+    std::string name;
+    Vec3 color{1, 1, 1};
+    double ambient = 0.1;
+    double diffuse = 0.6;
+    double phong = 0;
+    double phongSize = 40;
+    double reflection = 0;
+};
+
+struct Settings {
+    uint64_t seed = 0;
+    uint32_t maxDepth = 256;
+};
+
+struct Scene {
+    Camera camera;
+    std::vector<Light> lights;  // the builder fills in the default light when none is given
+    Vec3 background{0, 0, 0};
+    Settings settings;
+};
+
+// ---------------------------------------------------------------------------------------
+
+struct Graph {
+    std::vector<std::string> files;  // source file names, for FileLoc::file
+
+    std::vector<Node> nodes;
+    std::vector<NodeId> edges;
+    NodeId axiom = kNone;
+
+    std::vector<Module> modules;
+    std::vector<Transform> transforms;
+    std::vector<Calc> calcs;
+    std::vector<Assignment> assignments;
+    std::vector<Primitive> primitives;
+    std::vector<ExprId> args;  // arguments of transforms and primitives
+
+    std::vector<Expr> exprs;
+    std::vector<Instr> code;
+    std::vector<std::string> slotNames;  // parameter names, by slot
+    uint32_t randCallSites = 0;          // number of rand()/choose() call sites
+
+    std::vector<Material> materials;  // materials[0] is the default material
+    Scene scene;
+
+    // --- construction helpers (used by the builder and by tests) ---
+    NodeId addNode(NodeKind kind, uint32_t payload, const std::vector<NodeId>& children,
+                   FileLoc loc = {});
+    ExprId addConstant(double value, FileLoc loc = {});
+    ExprId addLoad(Slot slot, FileLoc loc = {});
+    Slot slot(const std::string& name);  // finds or creates the slot for a name
+
+    // --- queries ---
+    const NodeId* childrenOf(NodeId n) const { return edges.data() + nodes[n].firstChild; }
+    NodeId child(NodeId n, uint32_t i = 0) const { return edges[nodes[n].firstChild + i]; }
+    size_t slotCount() const { return slotNames.size(); }
+    // The bytes this graph occupies (its vectors' contents and strings): the
+    // "graph bytes" figure of the statistics.
+    size_t graphBytes() const;
+    // "file:line:col" for a location.
+    std::string where(FileLoc loc) const;
+};
+
+}  // namespace pcsg
