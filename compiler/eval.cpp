@@ -1,0 +1,395 @@
+// The shared evaluation code: see eval.h. Both renderers give a graph its meaning only
+// through these functions.
+#include "eval.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#include <fmt/format.h>
+
+namespace pcsg {
+
+// ---------------------------------------------------------------------------------------
+// Errors.
+
+RuntimeError::RuntimeError(FileLoc l, std::string msg)
+    : std::runtime_error(msg), loc(l), message(std::move(msg)) {}
+
+std::string RuntimeError::format(const Graph& g) const {
+    std::string out = fmt::format("{}: error: {}", g.where(loc), message);
+    if (!modulePath.empty()) {
+        // Long paths through one recursive module read better as runs: "S (x12) -> T".
+        out += "\n  module path: ";
+        for (size_t i = 0; i < modulePath.size();) {
+            size_t j = i;
+            while (j < modulePath.size() && modulePath[j] == modulePath[i]) ++j;
+            if (i > 0) out += " -> ";
+            out += modulePath[i];
+            if (j - i > 1) out += fmt::format(" (x{})", j - i);
+            i = j;
+        }
+    }
+    return out;
+}
+
+double unassigned() { return std::bit_cast<double>(kUnassignedBits); }
+bool isUnassigned(double v) { return std::bit_cast<uint64_t>(v) == kUnassignedBits; }
+
+void initFrame(const Graph& g, double* frame) {
+    const double u = unassigned();
+    for (size_t i = 0; i < g.slotCount(); ++i) frame[i] = u;
+}
+
+std::string describeFrame(const Graph& g, const double* frame) {
+    std::string out;
+    size_t shown = 0;
+    for (size_t i = 0; i < g.slotCount(); ++i) {
+        if (isUnassigned(frame[i])) continue;
+        if (shown == 12) {
+            out += ", ...";
+            break;
+        }
+        if (shown++) out += ", ";
+        out += fmt::format("{} = {}", g.slotNames[i], frame[i]);
+    }
+    return out.empty() ? std::string("no parameters assigned") : out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Instance paths and randomness.
+
+namespace {
+// SplitMix64's finaliser: a bijective 64-bit mixer.
+constexpr uint64_t mix64(uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+constexpr double toUnit(uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
+}  // namespace
+
+uint64_t pathChild(uint64_t path, uint32_t childIndex) {
+    return mix64(path ^ (0x6a09e667f3bcc908ULL + (static_cast<uint64_t>(childIndex) << 1)));
+}
+uint64_t pathRule(uint64_t path, uint32_t ruleIndex) {
+    return mix64(path ^ (0xbb67ae8584caa73bULL + (static_cast<uint64_t>(ruleIndex) << 1)));
+}
+
+double randOf(uint64_t seed, double x) {
+    if (x == 0) x = 0;  // -0 and +0 are the same argument
+    const uint64_t bits = std::bit_cast<uint64_t>(x);
+    return toUnit(mix64(mix64(bits ^ 0x3c6ef372fe94f82bULL) ^ mix64(seed + 0xa54ff53a5f1d36f1ULL)));
+}
+
+double randAt(uint64_t seed, uint64_t path, uint32_t callSite) {
+    return toUnit(mix64(mix64(path ^ mix64(seed + 0x510e527fade682d1ULL)) + callSite));
+}
+
+// ---------------------------------------------------------------------------------------
+// Expressions.
+
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+
+// sin and cos of an angle in degrees, exact at multiples of 90 so that rotz(90) maps +x
+// exactly to +y.
+double sinDeg(double a) {
+    const double r = std::fmod(a, 360.0);
+    if (r == 0 || r == 180 || r == -180) return 0;
+    if (r == 90 || r == -270) return 1;
+    if (r == -90 || r == 270) return -1;
+    return std::sin(a * kDegToRad);
+}
+double cosDeg(double a) { return sinDeg(a + 90.0); }
+
+[[noreturn]] void unassignedRead(const Graph& g, const Expr& e, Slot s) {
+    throw RuntimeError(e.loc, fmt::format("parameter '{}' is read before it is assigned on "
+                                          "this path (in '{}')",
+                                          g.slotNames[s], e.text));
+}
+
+double callFunc(Func f, const double* a, uint32_t n, uint64_t seed) {
+    switch (f) {
+        case Func::Sin: return sinDeg(a[0]);
+        case Func::Cos: return cosDeg(a[0]);
+        case Func::Tan: return sinDeg(a[0]) / cosDeg(a[0]);
+        case Func::Asin: return std::asin(a[0]) / kDegToRad;
+        case Func::Acos: return std::acos(a[0]) / kDegToRad;
+        case Func::Atan: return std::atan(a[0]) / kDegToRad;
+        case Func::Atan2: return std::atan2(a[0], a[1]) / kDegToRad;
+        case Func::Sqrt: return std::sqrt(a[0]);
+        case Func::Exp: return std::exp(a[0]);
+        case Func::Ln: return std::log(a[0]);
+        case Func::Log10: return std::log10(a[0]);
+        case Func::Pow: return std::pow(a[0], a[1]);
+        case Func::Abs: return std::fabs(a[0]);
+        case Func::Floor: return std::floor(a[0]);
+        case Func::Ceil: return std::ceil(a[0]);
+        case Func::Min: {
+            double m = a[0];
+            for (uint32_t i = 1; i < n; ++i) m = std::fmin(m, a[i]);
+            return m;
+        }
+        case Func::Max: {
+            double m = a[0];
+            for (uint32_t i = 1; i < n; ++i) m = std::fmax(m, a[i]);
+            return m;
+        }
+        case Func::Mod: return std::fmod(a[0], a[1]);
+        case Func::Clamp: return std::fmin(std::fmax(a[0], a[1]), a[2]);
+        case Func::Rand1: return randOf(seed, a[0]);
+    }
+    return std::nan("");
+}
+
+// choose(w1..wn): a rule number 1..n with probability proportional to the weights.
+double chooseRule(const Graph& g, const Expr& e, const double* w, uint32_t n, double u) {
+    double total = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!(w[i] >= 0) || !std::isfinite(w[i]))
+            throw RuntimeError(e.loc, fmt::format("choose() weight {} is {} in '{}': weights "
+                                                  "must be finite and not negative",
+                                                  i + 1, w[i], e.text));
+        total += w[i];
+    }
+    if (!(total > 0))
+        throw RuntimeError(e.loc, fmt::format("choose() weights are all zero in '{}'", e.text));
+    const double x = u * total;
+    double acc = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        acc += w[i];
+        if (x < acc && w[i] > 0) return i + 1;
+    }
+    for (uint32_t i = n; i-- > 0;)  // rounding: the last rule with a positive weight
+        if (w[i] > 0) return i + 1;
+    return n;
+}
+
+double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
+    const Instr* code = g.code.data();
+    const uint64_t seed = g.scene.settings.seed;
+    uint32_t sp = 0;
+    for (uint32_t pc = e.begin; pc < e.end;) {
+        const Instr& in = code[pc++];
+        switch (in.op) {
+            case Op::Const: stack[sp++] = in.imm; break;
+            case Op::Load: {
+                const double v = s.frame[in.a];
+                if (std::isnan(v) && isUnassigned(v)) unassignedRead(g, e, in.a);
+                stack[sp++] = v;
+                break;
+            }
+            case Op::Neg: stack[sp - 1] = -stack[sp - 1]; break;
+            case Op::Not: stack[sp - 1] = stack[sp - 1] == 0 ? 1.0 : 0.0; break;
+            case Op::ToBool: stack[sp - 1] = stack[sp - 1] != 0 ? 1.0 : 0.0; break;
+#define PCSG_BINARY(OP, EXPR)            \
+    case Op::OP: {                       \
+        const double b = stack[--sp];    \
+        const double a = stack[sp - 1];  \
+        stack[sp - 1] = (EXPR);          \
+        break;                           \
+    }
+            PCSG_BINARY(Add, a + b)
+            PCSG_BINARY(Sub, a - b)
+            PCSG_BINARY(Mul, a * b)
+            PCSG_BINARY(Div, a / b)
+            PCSG_BINARY(Mod, std::fmod(a, b))
+            PCSG_BINARY(Pow, std::pow(a, b))
+            PCSG_BINARY(Lt, a < b ? 1.0 : 0.0)
+            PCSG_BINARY(Le, a <= b ? 1.0 : 0.0)
+            PCSG_BINARY(Gt, a > b ? 1.0 : 0.0)
+            PCSG_BINARY(Ge, a >= b ? 1.0 : 0.0)
+            PCSG_BINARY(Eq, a == b ? 1.0 : 0.0)
+            PCSG_BINARY(Ne, a != b ? 1.0 : 0.0)
+#undef PCSG_BINARY
+            case Op::Jump: pc = in.a; break;
+            case Op::JumpIfZero:
+                if (stack[--sp] == 0) pc = in.a;
+                break;
+            case Op::Call: {
+                sp -= in.argc;
+                stack[sp] = callFunc(static_cast<Func>(in.a), stack + sp, in.argc, seed);
+                ++sp;
+                break;
+            }
+            case Op::Rand0: stack[sp++] = randAt(seed, s.path, in.a); break;
+            case Op::Choose: {
+                sp -= in.argc;
+                stack[sp] = chooseRule(g, e, stack + sp, in.argc, randAt(seed, s.path, in.a));
+                ++sp;
+                break;
+            }
+        }
+    }
+    return sp > 0 ? stack[sp - 1] : std::nan("");
+}
+
+}  // namespace
+
+double evalExpr(const Graph& g, ExprId id, EvalState s) {
+    const Expr& e = g.exprs[id];
+    constexpr uint32_t kSmall = 64;
+    if (e.maxStack <= kSmall) {
+        double stack[kSmall];
+        return run(g, e, s, stack);
+    }
+    std::vector<double> stack(e.maxStack);
+    return run(g, e, s, stack.data());
+}
+
+// ---------------------------------------------------------------------------------------
+// S-nodes, C-nodes, T-nodes, primitives.
+
+namespace {
+const Module& moduleOf(const Graph& g, NodeId n) { return g.modules[g.nodes[n].payload]; }
+
+[[noreturn]] void nonFinite(const Graph& g, const Expr& e, double v, const char* what,
+                            const double* frame) {
+    throw RuntimeError(e.loc, fmt::format("{} '{}' is {} (not a finite number) with {}", what,
+                                          e.text, v, describeFrame(g, frame)));
+}
+}  // namespace
+
+uint32_t selectRule(const Graph& g, NodeId n, EvalState s) {
+    const Module& m = moduleOf(g, n);
+    const uint32_t rules = g.nodes[n].childCount;
+    if (m.notationB) {
+        for (uint32_t i = 0; i < m.conditions.size() && i < rules; ++i) {
+            const ExprId c = m.conditions[i];
+            if (c == kNone) return i;
+            const double v = evalExpr(g, c, s);
+            if (!std::isfinite(v)) nonFinite(g, g.exprs[c], v, "the condition", s.frame);
+            if (v != 0) return i;
+        }
+        throw RuntimeError(m.loc, fmt::format("no rule of module {} applies with {}", m.name,
+                                              describeFrame(g, s.frame)));
+    }
+    const Expr& e = g.exprs[m.select];
+    const double v = evalExpr(g, m.select, s);
+    if (!std::isfinite(v)) nonFinite(g, e, v, fmt::format("the selection function of module {}", m.name).c_str(), s.frame);
+    const double r = std::round(v);
+    if (r < 1 || r > rules)
+        throw RuntimeError(e.loc, fmt::format("the selection function of module {} gave rule {}, "
+                                              "but {} has rules 1..{} (with {})",
+                                              m.name, r, m.name, rules, describeFrame(g, s.frame)));
+    return static_cast<uint32_t>(r) - 1;
+}
+
+void applyCalc(const Graph& g, NodeId n, EvalState in, double* out) {
+    const Calc& c = g.calcs[g.nodes[n].payload];
+    std::memcpy(out, in.frame, g.slotCount() * sizeof(double));
+    const Assignment* as = g.assignments.data() + c.first;
+    if (!c.simultaneous) {
+        const EvalState cur{out, in.path};
+        for (uint32_t i = 0; i < c.count; ++i) out[as[i].slot] = evalExpr(g, as[i].value, cur);
+        return;
+    }
+    constexpr uint32_t kSmall = 16;
+    double small[kSmall];
+    std::vector<double> big;
+    double* values = small;
+    if (c.count > kSmall) {
+        big.resize(c.count);
+        values = big.data();
+    }
+    for (uint32_t i = 0; i < c.count; ++i) values[i] = evalExpr(g, as[i].value, in);
+    for (uint32_t i = 0; i < c.count; ++i) out[as[i].slot] = values[i];
+}
+
+Affine makeTransform(TransformOp op, const double* a) {
+    Affine m;
+    switch (op) {
+        case TransformOp::Move: return Affine::translate({a[0], a[1], a[2]});
+        case TransformOp::Scale: return Affine::scale({a[0], a[1], a[2]});
+        case TransformOp::UScale: return Affine::scale({a[0], a[0], a[0]});
+        case TransformOp::RotX: {
+            const double c = cosDeg(a[0]), s = sinDeg(a[0]);
+            m.l[1][1] = c, m.l[1][2] = -s, m.l[2][1] = s, m.l[2][2] = c;
+            return m;
+        }
+        case TransformOp::RotY: {
+            const double c = cosDeg(a[0]), s = sinDeg(a[0]);
+            m.l[0][0] = c, m.l[0][2] = s, m.l[2][0] = -s, m.l[2][2] = c;
+            return m;
+        }
+        case TransformOp::RotZ: {
+            const double c = cosDeg(a[0]), s = sinDeg(a[0]);
+            m.l[0][0] = c, m.l[0][1] = -s, m.l[1][0] = s, m.l[1][1] = c;
+            return m;
+        }
+        case TransformOp::Rot: {
+            // Rodrigues' formula about the unit axis k: R = cI + s[k]x + (1-c) k k^T.
+            const double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            const Vec3 k{a[0] / len, a[1] / len, a[2] / len};
+            const double c = cosDeg(a[3]), s = sinDeg(a[3]), t = 1 - c;
+            m.l[0][0] = c + t * k.x * k.x;
+            m.l[0][1] = t * k.x * k.y - s * k.z;
+            m.l[0][2] = t * k.x * k.z + s * k.y;
+            m.l[1][0] = t * k.y * k.x + s * k.z;
+            m.l[1][1] = c + t * k.y * k.y;
+            m.l[1][2] = t * k.y * k.z - s * k.x;
+            m.l[2][0] = t * k.z * k.x - s * k.y;
+            m.l[2][1] = t * k.z * k.y + s * k.x;
+            m.l[2][2] = c + t * k.z * k.z;
+            return m;
+        }
+        case TransformOp::ZShear: m.l[2][0] = a[0], m.l[2][1] = a[1]; return m;
+        case TransformOp::FlipYZ: m.l[0][0] = -1; return m;
+        case TransformOp::FlipXZ: m.l[1][1] = -1; return m;
+        case TransformOp::FlipXY: m.l[2][2] = -1; return m;
+        case TransformOp::Matrix:
+            // POV-Ray's row-vector form p' = p·M + t: coordinate i of the result takes
+            // p_j times M[j][i], so L[i][j] = M[j][i] = a[3*j + i].
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) m.l[i][j] = a[3 * j + i];
+            m.t = {a[9], a[10], a[11]};
+            return m;
+    }
+    return m;
+}
+
+Affine transformMatrix(const Graph& g, NodeId n, EvalState s) {
+    const Transform& t = g.transforms[g.nodes[n].payload];
+    if (t.constant) return t.matrix;
+    double a[12];
+    for (uint32_t i = 0; i < t.argCount; ++i) {
+        const ExprId id = g.args[t.firstArg + i];
+        a[i] = evalExpr(g, id, s);
+        if (!std::isfinite(a[i])) nonFinite(g, g.exprs[id], a[i], "the transformation argument", s.frame);
+    }
+    const FileLoc loc = t.argCount ? g.exprs[g.args[t.firstArg]].loc : g.nodes[n].loc;
+    if (t.op == TransformOp::Rot && a[0] == 0 && a[1] == 0 && a[2] == 0)
+        throw RuntimeError(loc, fmt::format("rot() about the zero axis with {}", describeFrame(g, s.frame)));
+    const Affine m = makeTransform(t.op, a);
+    if (!(m.determinant() != 0) || !m.isFinite())
+        throw RuntimeError(loc, fmt::format("{} is singular (a zero scale factor?) with {}",
+                                            t.op == TransformOp::Matrix ? "matrix()" : "the transformation",
+                                            describeFrame(g, s.frame)));
+    return m;
+}
+
+void primitiveArgs(const Graph& g, NodeId n, EvalState s, double* out) {
+    const Primitive& p = g.primitives[g.nodes[n].payload];
+    if (p.constant) {
+        for (size_t i = 0; i < p.values.size(); ++i) out[i] = p.values[i];
+        return;
+    }
+    for (uint32_t i = 0; i < p.argCount; ++i) {
+        const ExprId id = g.args[p.firstArg + i];
+        out[i] = evalExpr(g, id, s);
+        if (!std::isfinite(out[i])) nonFinite(g, g.exprs[id], out[i], "the primitive argument", s.frame);
+    }
+}
+
+void checkDepth(const Graph& g, NodeId n, uint32_t depth, EvalState s) {
+    if (depth <= g.scene.settings.maxDepth) return;
+    const Module& m = moduleOf(g, n);
+    throw RuntimeError(m.loc, fmt::format("module {} reached depth {}, beyond settings max_depth "
+                                          "{}, with {}: does every path reach a terminating rule?",
+                                          m.name, depth, g.scene.settings.maxDepth,
+                                          describeFrame(g, s.frame)));
+}
+
+}  // namespace pcsg
