@@ -26,8 +26,10 @@ bool readLinear(const std::string& path, OIIO::ImageBuf& out, std::string& error
         return false;
     }
     const OIIO::ImageSpec& spec = in.spec();
-    const bool encoded = spec.format.basetype == OIIO::TypeDesc::UINT8 ||
-                         spec.format.basetype == OIIO::TypeDesc::UINT16;
+    // The file's own pixel type (the buffer holds floats): integer files are sRGB-encoded.
+    const OIIO::TypeDesc stored = in.nativespec().format;
+    const bool encoded = stored.basetype == OIIO::TypeDesc::UINT8 ||
+                         stored.basetype == OIIO::TypeDesc::UINT16;
     OIIO::ImageSpec rgb(spec.width, spec.height, 3, OIIO::TypeDesc::FLOAT);
     out.reset(rgb);
     const int channels = spec.nchannels;
