@@ -9,12 +9,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <regex>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "child_process.h"
+#include "renders.h"
 #include "commands.h"
 #include "image_compare.h"
 #include "stats.h"
@@ -54,44 +54,6 @@ struct SceneResult {
     std::string dir;  // where the images are, relative to the report root
 };
 
-std::optional<nlohmann::json> parseJson(const std::string& text) {
-    try {
-        // The JSON object is the last thing printed; anything before it is ignored.
-        const auto pos = text.find('{');
-        if (pos == std::string::npos) return std::nullopt;
-        return nlohmann::json::parse(text.substr(pos));
-    } catch (const std::exception&) {
-        return std::nullopt;
-    }
-}
-
-template <class T>
-std::optional<T> field(const nlohmann::json& j, const char* key) {
-    if (j.contains(key) && j[key].is_number()) return j[key].get<T>();
-    return std::nullopt;
-}
-
-std::string firstLines(const std::string& text, size_t n = 12) {
-    std::string out;
-    size_t lines = 0, pos = 0;
-    while (pos < text.size() && lines < n) {
-        size_t end = text.find('\n', pos);
-        if (end == std::string::npos) end = text.size();
-        out += "    " + text.substr(pos, end - pos) + "\n";
-        pos = end + 1;
-        ++lines;
-    }
-    return out;
-}
-
-// POV-Ray prints "Parse Time:    0 hours  0 minutes  1 seconds (1.234 seconds)".
-std::optional<double> povrayTime(const std::string& err, const char* what) {
-    const std::regex re(std::string(what) + R"(\s*Time:.*\(([0-9.]+) seconds\))");
-    std::smatch m;
-    if (std::regex_search(err, m, re)) return std::stod(m[1]);
-    return std::nullopt;
-}
-
 SceneResult verifyScene(const std::string& scene, const VerifyOptions& o, const fs::path& root) {
     SceneResult r;
     r.scene = scene;
@@ -101,67 +63,56 @@ SceneResult verifyScene(const std::string& scene, const VerifyOptions& o, const 
     std::error_code ec;
     fs::create_directories(work, ec);
     const int W = o.width * o.ss, H = o.height * o.ss;
-    const std::string self = selfExecutable();
-    const std::string threads = o.threads > 0 ? std::to_string(o.threads) : std::string();
+    const std::vector<std::string> threads =
+        o.threads > 0 ? std::vector<std::string>{"--threads", std::to_string(o.threads)}
+                      : std::vector<std::string>{};
 
     // 1. The native render of the cyclic graph.
     const fs::path nativeFull = work / "native_full.png";
-    std::vector<std::string> renderCmd = {self, "render", scene, "-o", nativeFull.string(),
-                                          "--width", std::to_string(W), "--height", std::to_string(H),
-                                          "--json"};
-    if (!threads.empty()) renderCmd.insert(renderCmd.end(), {"--threads", threads});
-    const ChildResult native = runChild(renderCmd);
-    if (native.exitCode != 0) {
-        r.message = "the native render failed:\n" + firstLines(native.err);
+    const RenderRun native = renderNative(scene, nativeFull.string(), W, H, threads);
+    if (!native.ok) {
+        r.message = native.error;
         return r;
     }
-    r.native.seconds = native.seconds;
-    r.native.peakRssBytes = native.peakRssBytes;
-    if (auto j = parseJson(native.out)) {
-        r.raysPerSecond = field<double>(*j, "rays_per_second");
-        r.graphBytes = field<uint64_t>(*j, "graph_bytes");
-    }
+    r.native.seconds = native.child.seconds;
+    r.native.peakRssBytes = native.child.peakRssBytes;
+    r.raysPerSecond = jsonField<double>(native.json, "rays_per_second");
+    r.graphBytes = jsonField<uint64_t>(native.json, "graph_bytes");
 
     // 2. The expanded tree: its size, and the POV-Ray text.
-    const ChildResult stats = runChild({self, "stats", scene, "--json"});
-    if (stats.exitCode == 0)
-        if (auto j = parseJson(stats.out)) {
-            r.expandedBytes = field<uint64_t>(*j, "expanded_bytes");
-            r.expandedNodes = field<uint64_t>(*j, "expanded_nodes");
-            r.primitives = field<uint64_t>(*j, "primitive_equivalence");
-            if (!r.graphBytes) r.graphBytes = field<uint64_t>(*j, "graph_bytes");
-        }
+    const RenderRun stats = expandedStats(scene);
+    r.expandedBytes = jsonField<uint64_t>(stats.json, "expanded_bytes");
+    r.expandedNodes = jsonField<uint64_t>(stats.json, "expanded_nodes");
+    r.primitives = jsonField<uint64_t>(stats.json, "primitive_equivalence");
+    if (!r.graphBytes) r.graphBytes = jsonField<uint64_t>(stats.json, "graph_bytes");
     fs::path pov = work / (r.name + ".pov");
     if (!o.povFile.empty()) {
         pov = o.povFile;
     } else {
-        const ChildResult exported = runChild({self, "export-pov", scene, "-o", pov.string(), "--width",
-                                               std::to_string(W), "--height", std::to_string(H)});
-        if (exported.exitCode != 0) {
-            r.message = "export-pov failed:\n" + firstLines(exported.err);
+        const RenderRun exported = exportPov(scene, pov.string(), W, H);
+        if (!exported.ok) {
+            r.message = exported.error;
             return r;
         }
     }
 
     // 3. POV-Ray on the exported text, without anti-aliasing, at the same size.
     const fs::path povFull = work / "povray_full.png";
-    std::vector<std::string> povCmd = {"povray", "+I" + pov.string(), "+O" + povFull.string(),
-                                       "+W" + std::to_string(W), "+H" + std::to_string(H), "-A",
-                                       "-D", "+FN", "-UA", "-P", "-V"};
-    if (!threads.empty()) povCmd.push_back("+WT" + threads);
-    const ChildResult povray = runChild(povCmd);
-    if (!povray.started) {
-        r.message = "POV-Ray is not installed: install it with `apt-get install povray`";
+    std::vector<std::string> povArgs = {"-A"};
+    if (o.threads > 0) povArgs.push_back("+WT" + std::to_string(o.threads));
+    const RenderRun povray = renderPovray(pov.string(), povFull.string(), W, H, povArgs);
+    if (!povray.child.started) {
+        r.message = povray.error;
         return r;
     }
-    if (povray.exitCode != 0 || !fs::exists(povFull)) {
+    if (!povray.ok) {
         r.status = 1;  // POV-Ray rejecting our exported text is a failure of the exporter
-        r.message = "POV-Ray could not render the exported scene:\n" + firstLines(povray.err, 20);
+        r.message = povray.error;
         return r;
     }
-    r.povray.seconds = povray.seconds;
-    r.povray.peakRssBytes = povray.peakRssBytes;
-    r.povray.parseSeconds = povrayTime(povray.err, "Parse");
+    r.povray.seconds = povray.child.seconds;
+    r.povray.peakRssBytes = povray.child.peakRssBytes;
+    r.povray.parseSeconds = povray.parseSeconds;
 
     // 4. The same box filter on both, then the comparison.
     OIIO::ImageBuf a, b;
