@@ -1,0 +1,769 @@
+// The lexer: scanning, #define expansion and the newline rule. See lexer.h.
+#include "lexer.h"
+
+#include <algorithm>
+#include <cstring>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+namespace pcsg {
+
+// ---------------------------------------------------------------------------------------
+// Source
+
+Source::Source(std::string_view text, uint32_t file) : text_(text), file_(file) {
+    lineStarts_.push_back(0);
+    const char* base = text.data();
+    const char* p = base;
+    const char* end = base + text.size();
+    while (p < end) {
+        const void* nl = std::memchr(p, '\n', static_cast<size_t>(end - p));
+        if (!nl) break;
+        p = static_cast<const char*>(nl) + 1;
+        lineStarts_.push_back(static_cast<uint32_t>(p - base));
+    }
+}
+
+FileLoc Source::loc(uint32_t offset) const {
+    // The last line start <= offset.
+    auto it = std::upper_bound(lineStarts_.begin(), lineStarts_.end(), offset);
+    const size_t line = static_cast<size_t>(it - lineStarts_.begin());  // 1-based
+    return FileLoc{file_, static_cast<uint32_t>(line), offset - lineStarts_[line - 1] + 1};
+}
+
+// ---------------------------------------------------------------------------------------
+// Keywords
+
+namespace {
+
+struct KeywordEntry {
+    std::string_view name;
+    Kw kw;
+};
+
+constexpr KeywordEntry kKeywords[] = {
+    {"camera", Kw::Camera},
+    {"light", Kw::Light},
+    {"background", Kw::Background},
+    {"material", Kw::Material},
+    {"settings", Kw::Settings},
+    {"paint", Kw::Paint},
+    {"move", Kw::Move},
+    {"translate", Kw::Translate},
+    {"scale", Kw::Scale},
+    {"uscale", Kw::UScale},
+    {"rotx", Kw::RotX},
+    {"roty", Kw::RotY},
+    {"rotz", Kw::RotZ},
+    {"rot", Kw::Rot},
+    {"zshear", Kw::ZShear},
+    {"flipyz", Kw::FlipYZ},
+    {"flipxz", Kw::FlipXZ},
+    {"flipxy", Kw::FlipXY},
+    {"matrix", Kw::Matrix},
+    {"sphere", Kw::Sphere},
+    {"cube", Kw::Cube},
+    {"cylinder", Kw::Cylinder},
+    {"cone", Kw::Cone},
+    {"tetrahedron", Kw::Tetrahedron},
+    {"torus", Kw::Torus},
+    {"plane", Kw::Plane},
+    {"empty", Kw::Empty},
+    {"tri1", Kw::Tri1},
+    {"tri2", Kw::Tri2},
+    {"triangle", Kw::Triangle},
+    {"if", Kw::If},
+    {"rand", Kw::Rand},
+    {"choose", Kw::Choose},
+    {"pi", Kw::Pi},
+    {"e", Kw::E},
+    {"sin", Kw::Sin},
+    {"cos", Kw::Cos},
+    {"tan", Kw::Tan},
+    {"asin", Kw::Asin},
+    {"acos", Kw::Acos},
+    {"atan", Kw::Atan},
+    {"atan2", Kw::Atan2},
+    {"sqrt", Kw::Sqrt},
+    {"exp", Kw::Exp},
+    {"ln", Kw::Ln},
+    {"log10", Kw::Log10},
+    {"pow", Kw::Pow},
+    {"abs", Kw::Abs},
+    {"floor", Kw::Floor},
+    {"ceil", Kw::Ceil},
+    {"min", Kw::Min},
+    {"max", Kw::Max},
+    {"mod", Kw::Mod},
+    {"clamp", Kw::Clamp},
+};
+
+const std::unordered_map<std::string_view, Kw>& keywordTable() {
+    static const std::unordered_map<std::string_view, Kw> table = [] {
+        std::unordered_map<std::string_view, Kw> t;
+        for (const auto& e : kKeywords) t.emplace(e.name, e.kw);
+        return t;
+    }();
+    return table;
+}
+
+}  // namespace
+
+Kw keywordOf(std::string_view word) {
+    // Every keyword is 1..11 lower-case letters or digits: most identifiers fail fast.
+    if (word.empty() || word.size() > 11 || word[0] < 'a' || word[0] > 'z') return Kw::None;
+    const auto& t = keywordTable();
+    auto it = t.find(word);
+    return it == t.end() ? Kw::None : it->second;
+}
+
+std::string_view keywordName(Kw k) {
+    for (const auto& e : kKeywords)
+        if (e.kw == k) return e.name;
+    return "?";
+}
+
+std::string_view spelling(const Source& src, const Token& t) {
+    if (t.kind == Tok::End || t.kind == Tok::Newline) return {};
+    return src.text().substr(t.offset, t.length);
+}
+
+std::string describe(const Source& src, const Token& t) {
+    switch (t.kind) {
+        case Tok::End: return "end of file";
+        case Tok::Newline: return (t.flags & kForced) ? "the start of a new rule" : "end of line";
+        case Tok::Number: return fmt::format("number '{}'", spelling(src, t));
+        default: break;
+    }
+    std::string_view s = spelling(src, t);
+    if (s.size() > 40) return fmt::format("'{}...'", s.substr(0, 40));
+    return fmt::format("'{}'", s);
+}
+
+// ---------------------------------------------------------------------------------------
+// Step 1: scanning
+
+namespace {
+
+bool isDigit(unsigned char c) { return c >= '0' && c <= '9'; }
+bool isIdentStart(unsigned char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+}
+bool isIdentChar(unsigned char c) { return isIdentStart(c) || isDigit(c); }
+
+bool full(const Diagnostics& d) { return d.errors().size() >= Diagnostics::kMaxErrors; }
+
+class Scanner {
+public:
+    Scanner(const Source& src, Diagnostics& diags, std::vector<Token>& out)
+        : src_(src), diags_(diags), s_(src.text()), out_(out) {}
+
+    void run() {
+        size_t i = 0;
+        const size_t n = s_.size();
+        if (n >= 3 && s_.substr(0, 3) == "\xEF\xBB\xBF") i = 3;  // a UTF-8 byte-order mark
+        while (i < n) {
+            const unsigned char c = static_cast<unsigned char>(s_[i]);
+            if (c == '\n') {
+                lineStart_ = true;
+                ++i;
+                continue;
+            }
+            if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
+                ++i;
+                continue;
+            }
+            if (c == '/' && i + 1 < n && s_[i + 1] == '/') {
+                const void* nl = std::memchr(s_.data() + i, '\n', n - i);
+                i = nl ? static_cast<size_t>(static_cast<const char*>(nl) - s_.data()) : n;
+                continue;
+            }
+            if (c == '/' && i + 1 < n && s_[i + 1] == '*') {
+                const size_t close = s_.find("*/", i + 2);
+                if (close == std::string_view::npos) {
+                    error(i, "unterminated /* comment");
+                    return;
+                }
+                // A comment spanning lines still separates the tokens around it by a line
+                // break.
+                if (std::memchr(s_.data() + i, '\n', close - i)) lineStart_ = true;
+                i = close + 2;
+                continue;
+            }
+            if (isDigit(c) || (c == '.' && i + 1 < n && isDigit(static_cast<unsigned char>(s_[i + 1])))) {
+                i = number(i);
+            } else if (isIdentStart(c)) {
+                size_t j = i + 1;
+                while (j < n && isIdentChar(static_cast<unsigned char>(s_[j]))) ++j;
+                const Kw kw = keywordOf(s_.substr(i, j - i));
+                push(kw == Kw::None ? Tok::Ident : Tok::Keyword, i, j - i, kw);
+                i = j;
+            } else if (c < 0x80) {
+                i = punctuation(i);
+            } else {
+                i = unicode(i);
+            }
+            if (stop_ || full(diags_)) return;
+        }
+    }
+
+private:
+    void error(size_t offset, std::string message) {
+        diags_.error(src_.loc(static_cast<uint32_t>(offset)), std::move(message));
+    }
+
+    void push(Tok kind, size_t offset, size_t length, Kw kw = Kw::None, uint8_t flags = 0) {
+        Token t;
+        t.kind = kind;
+        t.kw = kw;
+        t.flags = static_cast<uint8_t>(flags | (lineStart_ ? kLineStart : 0));
+        t.offset = static_cast<uint32_t>(offset);
+        t.length = static_cast<uint32_t>(length);
+        out_.push_back(t);
+        lineStart_ = false;
+    }
+
+    // number -> digits [ '.' digits ] [ ('e'|'E') ['+'|'-'] digits ]  |  '.' digits ...
+    size_t number(size_t i) {
+        const size_t n = s_.size();
+        const size_t start = i;
+        bool integer = true;
+        auto digit = [&](size_t k) { return k < n && isDigit(static_cast<unsigned char>(s_[k])); };
+        while (digit(i)) ++i;
+        if (i < n && s_[i] == '.') {
+            integer = false;
+            ++i;
+            while (digit(i)) ++i;
+        }
+        bool bad = false;
+        if (i < n && (s_[i] == 'e' || s_[i] == 'E')) {
+            size_t j = i + 1;
+            if (j < n && (s_[j] == '+' || s_[j] == '-')) ++j;
+            if (digit(j)) {
+                integer = false;
+                i = j;
+                while (digit(i)) ++i;
+            } else {
+                bad = true;
+            }
+        }
+        if (i < n && (isIdentChar(static_cast<unsigned char>(s_[i])) || s_[i] == '.')) bad = true;
+        if (bad) {
+            size_t j = i;
+            while (j < n && (isIdentChar(static_cast<unsigned char>(s_[j])) || s_[j] == '.' ||
+                             ((s_[j] == '+' || s_[j] == '-') && (s_[j - 1] == 'e' || s_[j - 1] == 'E'))))
+                ++j;
+            error(start, fmt::format("malformed number '{}'", s_.substr(start, std::min<size_t>(j - start, 40))));
+            push(Tok::Number, start, i - start, Kw::None, 0);
+            return j;
+        }
+        push(Tok::Number, start, i - start, Kw::None, integer ? kInteger : 0);
+        return i;
+    }
+
+    size_t punctuation(size_t i) {
+        const size_t n = s_.size();
+        const char c = s_[i];
+        const char d = i + 1 < n ? s_[i + 1] : '\0';
+        switch (c) {
+            case '(': push(Tok::LParen, i, 1); return i + 1;
+            case ')': push(Tok::RParen, i, 1); return i + 1;
+            case '{': push(Tok::LBrace, i, 1); return i + 1;
+            case '}': push(Tok::RBrace, i, 1); return i + 1;
+            case ',': push(Tok::Comma, i, 1); return i + 1;
+            case ';': push(Tok::Semicolon, i, 1); return i + 1;
+            case ':': push(Tok::Colon, i, 1); return i + 1;
+            case '+': push(Tok::Plus, i, 1); return i + 1;
+            case '*': push(Tok::Star, i, 1); return i + 1;
+            case '/': push(Tok::Slash, i, 1); return i + 1;
+            case '%': push(Tok::Percent, i, 1); return i + 1;
+            case '^': push(Tok::Caret, i, 1); return i + 1;
+            case '\\': push(Tok::Difference, i, 1); return i + 1;
+            case '#': push(Tok::Hash, i, 1); return i + 1;
+            case '-':
+                if (d == '>') {
+                    push(Tok::Arrow, i, 2);
+                    return i + 2;
+                }
+                push(Tok::Minus, i, 1);
+                return i + 1;
+            case '|':
+                if (d == '|') {
+                    push(Tok::OrOr, i, 2);
+                    return i + 2;
+                }
+                push(Tok::Union, i, 1);
+                return i + 1;
+            case '&':
+                if (d == '&') {
+                    push(Tok::AndAnd, i, 2);
+                    return i + 2;
+                }
+                push(Tok::Intersect, i, 1);
+                return i + 1;
+            case '=':
+                if (d == '=') {
+                    push(Tok::Eq, i, 2);
+                    return i + 2;
+                }
+                push(Tok::Assign, i, 1);
+                return i + 1;
+            case '!':
+                if (d == '=') {
+                    push(Tok::Ne, i, 2);
+                    return i + 2;
+                }
+                push(Tok::Bang, i, 1);
+                return i + 1;
+            case '<':
+                if (d == '=') {
+                    push(Tok::Le, i, 2);
+                    return i + 2;
+                }
+                push(Tok::Lt, i, 1);
+                return i + 1;
+            case '>':
+                if (d == '=') {
+                    push(Tok::Ge, i, 2);
+                    return i + 2;
+                }
+                push(Tok::Gt, i, 1);
+                return i + 1;
+            default: break;
+        }
+        if (c == '\0') {
+            error(i, "unexpected NUL byte: this does not look like a text file");
+            stop_ = true;
+            return n;
+        }
+        // Any other ASCII character: report a run of them once.
+        size_t j = i + 1;
+        while (j < n && static_cast<unsigned char>(s_[j]) < 0x80 && s_[j] != '\0' &&
+               badAscii(static_cast<unsigned char>(s_[j])))
+            ++j;
+        const unsigned char u = static_cast<unsigned char>(c);
+        if (u >= 0x20 && u < 0x7f)
+            error(i, fmt::format("unexpected character '{}'", c));
+        else
+            error(i, fmt::format("unexpected control character 0x{:02X}", u));
+        return j;
+    }
+
+    static bool badAscii(unsigned char c) {
+        if (isIdentChar(c) || c == ' ' || c == '\t' || c == '\n' || c == '\r') return false;
+        return std::strchr("(){},;:+-*/%^\\#|&=!<>.", c) == nullptr || c == 0;
+    }
+
+    // Multi-byte UTF-8: the Unicode operators, or an error.
+    size_t unicode(size_t i) {
+        const size_t n = s_.size();
+        const unsigned char c = static_cast<unsigned char>(s_[i]);
+        size_t len = 0;
+        uint32_t cp = 0;
+        if (c >= 0xC2 && c <= 0xDF) len = 2, cp = c & 0x1F;
+        else if (c >= 0xE0 && c <= 0xEF) len = 3, cp = c & 0x0F;
+        else if (c >= 0xF0 && c <= 0xF4) len = 4, cp = c & 0x07;
+        bool ok = len != 0 && i + len <= n;
+        for (size_t k = 1; ok && k < len; ++k) {
+            const unsigned char cc = static_cast<unsigned char>(s_[i + k]);
+            if ((cc & 0xC0) != 0x80) ok = false;
+            cp = (cp << 6) | (cc & 0x3F);
+        }
+        if (ok && ((len == 3 && cp < 0x800) || (len == 4 && (cp < 0x10000 || cp > 0x10FFFF)) ||
+                   (cp >= 0xD800 && cp <= 0xDFFF)))
+            ok = false;
+        if (!ok) {
+            error(i, fmt::format("invalid UTF-8 byte 0x{:02X}", c));
+            // Skip the rest of a run of bytes that are not ASCII.
+            size_t j = i + 1;
+            while (j < n && static_cast<unsigned char>(s_[j]) >= 0x80) ++j;
+            return j;
+        }
+        switch (cp) {
+            case 0x222A: push(Tok::Union, i, len); return i + len;       // ∪
+            case 0x2229: push(Tok::Intersect, i, len); return i + len;   // ∩
+            case 0x2216: push(Tok::Difference, i, len); return i + len;  // ∖ (set minus)
+            case 0x2192: push(Tok::Arrow, i, len); return i + len;       // →
+            default: break;
+        }
+        if (cp == 0xA0 || cp == 0x2009 || cp == 0x202F || cp == 0x200B) return i + len;  // spaces
+        error(i, fmt::format("unexpected character '{}' (U+{:04X})", s_.substr(i, len), cp));
+        return i + len;
+    }
+
+    const Source& src_;
+    Diagnostics& diags_;
+    std::string_view s_;
+    std::vector<Token>& out_;
+    bool lineStart_ = true;
+    bool stop_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// Step 2: #define
+
+class Expander {
+public:
+    Expander(const Source& src, Diagnostics& diags, const std::vector<Token>& raw,
+             std::vector<Token>& out)
+        : src_(src), diags_(diags), raw_(raw), out_(out) {}
+
+    void run() {
+        collect();
+        const size_t n = raw_.size() - 1;  // the last token is End
+        out_.reserve(n + 1);
+        size_t i = 0;
+        while (i < n && !stop_) {
+            const Token& t = raw_[i];
+            if (t.kind == Tok::Hash) {
+                i = directive(i);
+                continue;
+            }
+            if (t.kind == Tok::Ident && !macros_.empty()) {
+                auto it = byName_.find(spelling(src_, t));
+                if (it != byName_.end()) {
+                    use(it->second, t, t.flags & kLineStart);
+                    ++i;
+                    continue;
+                }
+            }
+            emit(t);
+            ++i;
+        }
+        out_.push_back(raw_.back());
+    }
+
+private:
+    struct Macro {
+        std::string_view name;
+        uint32_t hash = 0;                     // raw index of its '#'
+        uint32_t bodyBegin = 0, bodyEnd = 0;   // raw indices
+        bool defined = false;                  // its #define has been passed
+        bool reported = false;                 // its self-expansion was reported
+    };
+    struct Frame {
+        uint32_t macro;
+        uint32_t pos;
+        uint32_t origin;
+        bool lineStart;
+    };
+
+    void error(const Token& t, std::string message) {
+        diags_.error(src_.loc(t.offset), std::move(message));
+    }
+
+    bool sameLine(size_t i) const { return i < raw_.size() && raw_[i].kind != Tok::End && !(raw_[i].flags & kLineStart); }
+
+    // The first #define of every name, so that a use before it can be recognised.
+    void collect() {
+        const size_t n = raw_.size() - 1;
+        for (size_t i = 0; i + 2 < n; ++i) {
+            if (raw_[i].kind != Tok::Hash || !(raw_[i].flags & kLineStart)) continue;
+            if (!sameLine(i + 1) || raw_[i + 1].kind != Tok::Ident ||
+                spelling(src_, raw_[i + 1]) != "define")
+                continue;
+            if (!sameLine(i + 2) || raw_[i + 2].kind != Tok::Ident) continue;
+            const std::string_view name = spelling(src_, raw_[i + 2]);
+            if (byName_.count(name)) continue;
+            Macro m;
+            m.name = name;
+            m.hash = static_cast<uint32_t>(i);
+            byName_.emplace(name, static_cast<uint32_t>(macros_.size()));
+            macros_.push_back(m);
+        }
+        active_.assign(macros_.size(), 0);
+    }
+
+    size_t skipLine(size_t i) const {
+        while (i < raw_.size() - 1 && !(raw_[i].flags & kLineStart)) ++i;
+        return i;
+    }
+
+    // The index just past the '}' matching the '{' at i, or 0 when it is not closed.
+    size_t matchBrace(size_t i) const {
+        size_t depth = 0;
+        for (size_t k = i; k < raw_.size() - 1; ++k) {
+            if (raw_[k].kind == Tok::LBrace) ++depth;
+            else if (raw_[k].kind == Tok::RBrace && --depth == 0) return k + 1;
+            else if (raw_[k].kind == Tok::Hash && (raw_[k].flags & kLineStart)) return 0;
+        }
+        return 0;
+    }
+
+    // #define NAME body. Returns the raw index after it.
+    size_t directive(size_t i) {
+        const Token& hash = raw_[i];
+        if (!(hash.flags & kLineStart)) {
+            error(hash, "'#' must be the first thing on its line");
+            return skipLine(i + 1);
+        }
+        if (!sameLine(i + 1) || spelling(src_, raw_[i + 1]) != "define") {
+            if (sameLine(i + 1))
+                error(raw_[i + 1], fmt::format("unknown directive '#{}': only #define is supported",
+                                               spelling(src_, raw_[i + 1])));
+            else
+                error(hash, "expected 'define' after '#'");
+            return skipLine(i + 1);
+        }
+        if (!sameLine(i + 2) || (raw_[i + 2].kind != Tok::Ident && raw_[i + 2].kind != Tok::Keyword)) {
+            error(sameLine(i + 2) ? raw_[i + 2] : raw_[i + 1], "expected a macro name after #define");
+            return skipLine(i + 2);
+        }
+        const Token& nameTok = raw_[i + 2];
+        const std::string_view name = spelling(src_, nameTok);
+        if (nameTok.kind == Tok::Keyword) {
+            error(nameTok, fmt::format("'{}' is a keyword and cannot be a macro name", name));
+            return skipLine(i + 3);
+        }
+        // The body.
+        size_t begin = i + 3, end = begin, next = begin;
+        if (sameLine(begin)) {
+            const size_t lineEnd = skipLine(begin);
+            if (raw_[begin].kind == Tok::LBrace) {
+                const size_t close = matchBrace(begin);
+                if (close == 0) {
+                    error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", name));
+                    stop_ = true;
+                    return raw_.size() - 1;
+                }
+                if (close > lineEnd && sameLine(close)) {
+                    error(raw_[close], fmt::format("unexpected {} after the block of #define {}",
+                                                   describe(src_, raw_[close]), name));
+                    end = close;
+                    next = skipLine(close);
+                } else {
+                    end = next = std::max(close, lineEnd);
+                }
+            } else {
+                end = next = lineEnd;
+            }
+        } else if (begin < raw_.size() - 1 && raw_[begin].kind == Tok::LBrace) {
+            // The paper's figure 8: the name alone, the block on the following lines.
+            const size_t close = matchBrace(begin);
+            if (close == 0) {
+                error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", name));
+                stop_ = true;
+                return raw_.size() - 1;
+            }
+            end = close;
+            next = close;
+            if (sameLine(close)) {
+                error(raw_[close], fmt::format("unexpected {} after the block of #define {}",
+                                               describe(src_, raw_[close]), name));
+                next = skipLine(close);
+            }
+        }
+        const uint32_t index = byName_.at(name);
+        Macro& m = macros_[index];
+        if (m.hash != i) {
+            error(nameTok, fmt::format("macro '{}' is already defined at line {}", name,
+                                       src_.loc(raw_[m.hash].offset).line));
+            return next;
+        }
+        for (size_t k = begin; k < end; ++k) {
+            if (raw_[k].kind == Tok::Hash) {
+                error(raw_[k], fmt::format("'#' inside the body of #define {}", name));
+                end = k;
+                break;
+            }
+            if (raw_[k].kind == Tok::Ident && spelling(src_, raw_[k]) == name && !m.reported) {
+                error(raw_[k], fmt::format("macro '{}' expands into itself", name));
+                m.reported = true;
+            }
+        }
+        m.bodyBegin = static_cast<uint32_t>(begin);
+        m.bodyEnd = static_cast<uint32_t>(end);
+        m.defined = true;
+        return next;
+    }
+
+    void emit(Token t) {
+        if (out_.size() >= kMaxExpandedTokens) {
+            if (!stop_)
+                error(t, fmt::format("macro expansion makes more than {} tokens", kMaxExpandedTokens));
+            stop_ = true;
+            return;
+        }
+        out_.push_back(t);
+    }
+
+    // Expands one use of a macro, iteratively (a chain of macros never deepens the stack).
+    void use(uint32_t index, const Token& at, bool lineStart) {
+        if (!usable(index, at)) {
+            Token t = at;
+            emit(t);
+            return;
+        }
+        frames_.clear();
+        push(index, lineStart);
+        while (!frames_.empty() && !stop_) {
+            Frame& f = frames_.back();
+            const Macro& m = macros_[f.macro];
+            if (f.pos >= m.bodyEnd) {
+                active_[f.macro] = 0;
+                frames_.pop_back();
+                continue;
+            }
+            Token t = raw_[f.pos];
+            const bool first = f.pos == m.bodyBegin;
+            ++f.pos;
+            const bool ls = first ? f.lineStart : (t.flags & kLineStart) != 0;
+            t.flags = static_cast<uint8_t>((t.flags & ~kLineStart) | (ls ? kLineStart : 0));
+            t.origin = f.origin;
+            if (t.kind == Tok::Ident) {
+                auto it = byName_.find(spelling(src_, t));
+                if (it != byName_.end() && usable(it->second, t)) {
+                    push(it->second, ls);  // invalidates f
+                    continue;
+                }
+            }
+            emit(t);
+        }
+        for (const Frame& f : frames_) active_[f.macro] = 0;
+        frames_.clear();
+    }
+
+    // Whether a macro may be expanded here; reports why not.
+    bool usable(uint32_t index, const Token& at) {
+        Macro& m = macros_[index];
+        if (!m.defined) {
+            error(at, fmt::format("macro '{}' is used before its #define at line {}", m.name,
+                                  src_.loc(raw_[m.hash].offset).line));
+            return false;
+        }
+        if (active_[index]) {
+            if (!m.reported)
+                error(at, fmt::format("macro '{}' expands into itself", m.name));
+            m.reported = true;
+            return false;
+        }
+        return true;
+    }
+
+    void push(uint32_t index, bool lineStart) {
+        active_[index] = 1;
+        frames_.push_back(Frame{index, macros_[index].bodyBegin, ++origins_, lineStart});
+    }
+
+    const Source& src_;
+    Diagnostics& diags_;
+    const std::vector<Token>& raw_;
+    std::vector<Token>& out_;
+    std::vector<Macro> macros_;
+    std::unordered_map<std::string_view, uint32_t> byName_;
+    std::vector<uint8_t> active_;
+    std::vector<Frame> frames_;
+    uint32_t origins_ = 0;
+    bool stop_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// Step 3: the newline rule
+
+bool isDirectiveKeyword(const Token& t) {
+    return t.kind == Tok::Keyword && (t.kw == Kw::Camera || t.kw == Kw::Light ||
+                                      t.kw == Kw::Background || t.kw == Kw::Material ||
+                                      t.kw == Kw::Settings);
+}
+
+// Whether a statement (or an item inside braces) may end after this token.
+bool canEnd(const Token& t, bool directive) {
+    switch (t.kind) {
+        case Tok::Number:
+        case Tok::Ident:
+        case Tok::Keyword:
+        case Tok::RParen: return true;
+        // A directive's '}' and a vector's '>' end an item; a C-node's '}' needs its operand.
+        case Tok::RBrace:
+        case Tok::Gt: return directive;
+        default: return false;
+    }
+}
+
+void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
+    out.reserve(in.size() + in.size() / 8 + 1);
+    std::vector<uint8_t> brackets;  // '(' or '{', innermost last
+    bool directive = false, statementStart = true;
+    Token prev;  // the last token pushed (kind End: none yet)
+    bool any = false;
+    auto newline = [&](uint8_t flags) {
+        Token nl;
+        nl.kind = Tok::Newline;
+        nl.flags = flags;
+        nl.offset = prev.offset + prev.length;
+        nl.origin = prev.origin;
+        out.push_back(nl);
+    };
+    for (size_t i = 0; i < in.size(); ++i) {
+        Token t = in[i];
+        if ((t.flags & kLineStart) && any) {
+            const bool ruleStart = (t.kind == Tok::Ident || (t.kind == Tok::Number && (t.flags & kInteger))) &&
+                                   i + 1 < in.size() && in[i + 1].kind == Tok::Colon;
+            if (!brackets.empty() && ruleStart) {
+                // Unbalanced brackets before a line that starts a rule: end the statement
+                // there, so that one missing ')' costs one error, not the rest of the file.
+                newline(kTopLevel | kForced);
+                brackets.clear();
+                statementStart = true;
+            } else if (canEnd(prev, directive)) {
+                if (brackets.empty()) {
+                    newline(kTopLevel);
+                    statementStart = true;
+                } else if (brackets.back() == '{') {
+                    newline(0);
+                }
+            }
+        }
+        if (t.kind == Tok::End) {
+            out.push_back(t);
+            break;
+        }
+        if (statementStart && brackets.empty()) {
+            directive = isDirectiveKeyword(t);
+            statementStart = false;
+        }
+        switch (t.kind) {
+            case Tok::LParen: brackets.push_back('('); break;
+            case Tok::LBrace: brackets.push_back('{'); break;
+            case Tok::RParen:
+            case Tok::RBrace:
+                if (!brackets.empty()) brackets.pop_back();
+                break;
+            case Tok::Semicolon:
+                if (brackets.empty()) {
+                    t.flags |= kTopLevel;
+                    statementStart = true;
+                }
+                break;
+            default: break;
+        }
+        out.push_back(t);
+        prev = t;
+        any = true;
+    }
+}
+
+}  // namespace
+
+TokenStream lex(const Source& src, Diagnostics& diags) {
+    std::vector<Token> raw;
+    raw.reserve(src.text().size() / 4 + 16);
+    Scanner(src, diags, raw).run();
+    Token end;
+    end.kind = Tok::End;
+    end.flags = kLineStart;
+    end.offset = static_cast<uint32_t>(src.text().size());
+    raw.push_back(end);
+
+    std::vector<Token> expanded;
+    Expander(src, diags, raw, expanded).run();
+    raw.clear();
+    raw.shrink_to_fit();
+
+    TokenStream ts;
+    applyNewlineRule(expanded, ts.tokens);
+    return ts;
+}
+
+}  // namespace pcsg

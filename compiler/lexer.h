@@ -1,0 +1,116 @@
+// The lexer: .pcsg text -> tokens (LANGUAGE.md sections 1 and 2).
+//
+// Three steps, each linear in the input:
+//  1. scan: bytes -> raw tokens (comments and blanks dropped, each token knowing whether
+//     it is the first on its line);
+//  2. #define: collect the object-like macros and expand them as tokens;
+//  3. the newline rule: insert a Newline token where a line break ends a statement (or
+//     separates items inside `{ }`), so the parser never looks at line breaks itself.
+//
+// Tokens do not own text: they point into the source (a macro's expansion points into
+// its #define body), so a token is 16 bytes whatever it spells.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "diagnostics.h"
+#include "graph.h"
+
+namespace pcsg {
+
+// One source text and its line table: byte offsets -> FileLoc.
+class Source {
+public:
+    Source(std::string_view text, uint32_t file);
+    std::string_view text() const { return text_; }
+    uint32_t file() const { return file_; }
+    // 1-based line and column (in bytes) of a byte offset; an offset at or past the end
+    // lies on the last line.
+    FileLoc loc(uint32_t offset) const;
+
+private:
+    std::string_view text_;
+    uint32_t file_;
+    std::vector<uint32_t> lineStarts_;
+};
+
+enum class Tok : uint8_t {
+    End,        // end of the file
+    Newline,    // a line break that ends a statement or separates items in { }
+    Semicolon,  // ;
+    Comma,      // ,
+    Colon,      // :
+    LParen, RParen, LBrace, RBrace,
+    Arrow,       // -> or →
+    Union,       // | or ∪
+    Intersect,   // & or ∩
+    Difference,  // '\'
+    Assign,      // =
+    Eq, Ne, Lt, Le, Gt, Ge,
+    Plus, Minus, Star, Slash, Percent, Caret, Bang,
+    AndAnd, OrOr,
+    Number,
+    Ident,
+    Keyword,
+    Hash,  // # (only in raw tokens: #define lines never reach the parser)
+};
+
+enum class Kw : uint8_t {
+    None,
+    // scene directives
+    Camera, Light, Background, Material, Settings,
+    // CSG
+    Paint,
+    Move, Translate, Scale, UScale, RotX, RotY, RotZ, Rot, ZShear, FlipYZ, FlipXZ, FlipXY,
+    Matrix,
+    Sphere, Cube, Cylinder, Cone, Tetrahedron, Torus, Plane, Empty, Tri1, Tri2, Triangle,
+    // expressions
+    If, Rand, Choose, Pi, E,
+    Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Exp, Ln, Log10, Pow, Abs, Floor, Ceil,
+    Min, Max, Mod, Clamp,
+};
+
+// Token flags.
+enum : uint8_t {
+    kLineStart = 1,  // the first token on its source line
+    kInteger = 2,    // a Number spelled with digits only (a rule number)
+    kTopLevel = 4,   // a Newline or ';' that ends a statement (not inside brackets)
+    kForced = 8,     // a Newline the lexer inserted to close unbalanced brackets
+};
+
+struct Token {
+    Tok kind = Tok::End;
+    uint8_t flags = 0;
+    Kw kw = Kw::None;
+    uint8_t pad = 0;
+    uint32_t offset = 0;  // into the source text
+    uint32_t length = 0;
+    uint32_t origin = 0;  // 0: the file itself; k > 0: the k-th macro expansion
+
+    bool is(Tok t) const { return kind == t; }
+    bool isKw(Kw k) const { return kind == Tok::Keyword && kw == k; }
+};
+
+struct TokenStream {
+    std::vector<Token> tokens;  // always ends with Tok::End
+};
+
+// Lexes and expands `src`. Errors go to `diags`; the stream is usable (ends with End)
+// even then, so that the parser can report more errors.
+TokenStream lex(const Source& src, Diagnostics& diags);
+
+// The spelling of a token ("end of line" for a Newline): for messages.
+std::string describe(const Source& src, const Token& t);
+std::string_view spelling(const Source& src, const Token& t);
+// The keyword spelled by an identifier, or Kw::None.
+Kw keywordOf(std::string_view word);
+std::string_view keywordName(Kw k);
+
+// Size limits (LANGUAGE.md section 8: never crash or hang, whatever the input).
+inline constexpr size_t kMaxSourceBytes = size_t(256) << 20;  // 256 MB
+inline constexpr size_t kMaxExpandedTokens = size_t(32) << 20;
+
+}  // namespace pcsg
