@@ -119,6 +119,13 @@ struct Ast {
     std::vector<Assign> assigns;
     std::vector<DirectiveItem> items;
     std::vector<uint32_t> lists;  // operand, argument and formal lists
+
+    // What syntax errors left out, so that the builder does not report their echoes:
+    // the names that a dropped statement may have declared or defined (token indices),
+    // whether a dropped statement may have been the axiom, and how many were dropped.
+    std::vector<uint32_t> droppedNames;
+    bool droppedAxiom = false;
+    uint32_t dropped = 0;
 };
 
 }  // namespace pcsg

@@ -79,6 +79,7 @@ public:
     std::optional<Graph> run() {
         const size_t errorsBefore = diags_.errors().size();
         g_.files = diags_.fileNames();
+        for (uint32_t tok : ast_.droppedNames) dropped_.insert(text(tok));
         g_.materials.push_back(Material{"default"});
         directives();
         declarations();
@@ -97,6 +98,9 @@ private:
     FileLoc loc(uint32_t tok) const { return src_.loc(t_[tok].offset); }
     std::string_view text(uint32_t tok) const { return spelling(src_, t_[tok]); }
     void error(uint32_t tok, std::string message) { diags_.error(loc(tok), std::move(message)); }
+    // Whether a statement that failed to parse may have declared this name: then errors
+    // about the name are echoes of the syntax error, and not reported.
+    bool dropped(std::string_view name) const { return dropped_.count(name) != 0; }
     uint32_t line(uint32_t tok) const { return loc(tok).line; }
 
     // The source text of tokens [from, to], one space where the source had any gap.
@@ -421,7 +425,7 @@ private:
                 error(d.nameTok, fmt::format("'{}' is a module (line {}) and cannot also be a definition",
                                              m.name, line(m.firstTok)));
             }
-            if (m.notationB) continue;
+            if (m.notationB || dropped(m.name)) continue;
             if (m.decl == kNoNode) {
                 error(ast_.stmts[m.rules[0]].nameTok,
                       fmt::format("module {} is not declared: add a line '{} <selection function>' "
@@ -501,7 +505,7 @@ private:
             error(s.tok, fmt::format("a second axiom (the first is at line {}): a file has exactly one",
                                      line(axiom_->tok)));
         }
-        if (!axiom_)
+        if (!axiom_ && !ast_.droppedAxiom)
             diags_.error(FileLoc{src_.file(), 1, 1},
                          "the file has no axiom: a statement that is the object itself, such as "
                          "'{c = 6} S' or 'w: S(6)'");
@@ -686,7 +690,8 @@ private:
                 if (name != "default") {
                     auto it = materialByName_.find(name);
                     if (it == materialByName_.end()) {
-                        error(n.nameTok, fmt::format("unknown material '{}'{}", name,
+                        if (!dropped(name))
+                            error(n.nameTok, fmt::format("unknown material '{}'{}", name,
                                                      materialByName_.empty() ? " (no material is defined)" : ""));
                         return child;
                     }
@@ -710,6 +715,7 @@ private:
             auto built = definitionNode_.find(d->second);
             return built != definitionNode_.end() ? built->second : placeholder();
         }
+        if (dropped(name)) return placeholder();
         if (assigned_.count(name))
             error(n.nameTok, fmt::format("'{}' is a parameter, not a module or definition", name));
         else
@@ -721,6 +727,7 @@ private:
         const std::string_view name = text(n.nameTok);
         auto it = moduleByName_.find(name);
         if (it == moduleByName_.end()) {
+            if (dropped(name)) return placeholder();
             if (definitionByName_.count(name))
                 error(n.nameTok, fmt::format("definition '{}' takes no arguments", name));
             else
@@ -874,7 +881,8 @@ private:
                 const std::string_view name = text(n.tok);
                 if (constantOnly_) {
                     error(n.tok, fmt::format("'{}': the values of a directive are constants, not parameters", name));
-                } else if (!assigned_.count(name) && reportedUnknown_.insert(name).second) {
+                } else if (!assigned_.count(name) && ast_.dropped == 0 &&
+                           reportedUnknown_.insert(name).second) {
                     error(n.tok, fmt::format("unknown parameter '{}': no C-node or formal parameter assigns it", name));
                 }
                 emit(Op::Load, g_.slot(std::string(name)));
@@ -1111,6 +1119,7 @@ private:
     std::unordered_set<uint32_t> cyclic_;
     std::unordered_set<std::string_view> assigned_;
     std::unordered_set<std::string_view> reportedUnknown_;
+    std::unordered_set<std::string_view> dropped_;
     const Stmt* axiom_ = nullptr;
     NodeId placeholder_ = kNone;
     bool constantOnly_ = false;

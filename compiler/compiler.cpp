@@ -31,8 +31,12 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
         return std::nullopt;
     }
     const Ast ast = parse(src, tokens, diags);
+    if (diags.errors().size() >= Diagnostics::kMaxErrors) return std::nullopt;
+    // The builder's checks run even after syntax errors (they are told what was dropped),
+    // so that one run reports as many independent errors as it can.
+    std::optional<Graph> g = build(src, tokens, ast, diags);
     if (diags.errors().size() != errorsBefore) return std::nullopt;
-    return build(src, tokens, ast, diags);
+    return g;
 }
 
 std::optional<Graph> compileFile(const std::string& path, std::string& storage,

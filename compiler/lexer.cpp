@@ -420,13 +420,10 @@ public:
                 i = directive(i);
                 continue;
             }
-            if (t.kind == Tok::Ident && !macros_.empty()) {
-                auto it = byName_.find(spelling(src_, t));
-                if (it != byName_.end()) {
-                    use(it->second, t, t.flags & kLineStart);
-                    ++i;
-                    continue;
-                }
+            if (macroAt_[i] != kNotMacro) {
+                use(macroAt_[i], t, t.flags & kLineStart);
+                ++i;
+                continue;
             }
             emit(t);
             ++i;
@@ -473,6 +470,14 @@ private:
             macros_.push_back(m);
         }
         active_.assign(macros_.size(), 0);
+        // Which raw identifiers name a macro: one look-up per token, whatever expands.
+        macroAt_.assign(raw_.size(), kNotMacro);
+        if (macros_.empty()) return;
+        for (size_t i = 0; i < raw_.size(); ++i) {
+            if (raw_[i].kind != Tok::Ident) continue;
+            auto it = byName_.find(spelling(src_, raw_[i]));
+            if (it != byName_.end()) macroAt_[i] = it->second;
+        }
     }
 
     size_t skipLine(size_t i) const {
@@ -579,9 +584,9 @@ private:
     }
 
     void emit(Token t) {
-        if (out_.size() >= kMaxExpandedTokens) {
+        if (out_.size() >= raw_.size() + kMaxExpansionTokens) {
             if (!stop_)
-                error(t, fmt::format("macro expansion makes more than {} tokens", kMaxExpandedTokens));
+                error(t, fmt::format("macro expansion makes more than {} tokens", out_.size()));
             stop_ = true;
             return;
         }
@@ -605,18 +610,17 @@ private:
                 frames_.pop_back();
                 continue;
             }
+            const uint32_t rawIndex = f.pos;
             Token t = raw_[f.pos];
             const bool first = f.pos == m.bodyBegin;
             ++f.pos;
             const bool ls = first ? f.lineStart : (t.flags & kLineStart) != 0;
             t.flags = static_cast<uint8_t>((t.flags & ~kLineStart) | (ls ? kLineStart : 0));
             t.origin = f.origin;
-            if (t.kind == Tok::Ident) {
-                auto it = byName_.find(spelling(src_, t));
-                if (it != byName_.end() && usable(it->second, t)) {
-                    push(it->second, ls);  // invalidates f
-                    continue;
-                }
+            const uint32_t inner = macroAt_[rawIndex];
+            if (inner != kNotMacro && usable(inner, t)) {
+                push(inner, ls);  // invalidates f
+                continue;
             }
             emit(t);
         }
@@ -652,6 +656,8 @@ private:
     std::vector<Token>& out_;
     std::vector<Macro> macros_;
     std::unordered_map<std::string_view, uint32_t> byName_;
+    static constexpr uint32_t kNotMacro = UINT32_MAX;
+    std::vector<uint32_t> macroAt_;  // raw index -> macro, or kNotMacro
     std::vector<uint8_t> active_;
     std::vector<Frame> frames_;
     uint32_t origins_ = 0;
@@ -697,7 +703,7 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
     };
     for (size_t i = 0; i < in.size(); ++i) {
         Token t = in[i];
-        if ((t.flags & kLineStart) && any) {
+        if ((t.flags & kLineStart) && any && t.kind != Tok::End) {
             const bool ruleStart = (t.kind == Tok::Ident || (t.kind == Tok::Number && (t.flags & kInteger))) &&
                                    i + 1 < in.size() && in[i + 1].kind == Tok::Colon;
             if (!brackets.empty() && ruleStart) {

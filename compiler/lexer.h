@@ -111,6 +111,7 @@ std::string_view keywordName(Kw k);
 
 // Size limits (LANGUAGE.md section 8: never crash or hang, whatever the input).
 inline constexpr size_t kMaxSourceBytes = size_t(256) << 20;  // 256 MB
-inline constexpr size_t kMaxExpandedTokens = size_t(32) << 20;
+// Macro expansion may add at most this many tokens to a file's own.
+inline constexpr size_t kMaxExpansionTokens = size_t(1) << 20;
 
 }  // namespace pcsg

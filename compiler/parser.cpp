@@ -82,6 +82,7 @@ public:
                 continue;
             }
             if (diags_.errors().size() >= Diagnostics::kMaxErrors) break;
+            const size_t start = p_;
             try {
                 depth_ = 0;
                 assignIsEq_ = false;
@@ -91,6 +92,7 @@ public:
             } catch (const Abort&) {
                 // Panic mode: the statement is dropped (statements are added only once
                 // parsed); resume after its end.
+                dropped(start);
                 while (!at(Tok::End) && !((at(Tok::Newline) || at(Tok::Semicolon)) && (tok().flags & kTopLevel)))
                     ++p_;
             }
@@ -99,6 +101,25 @@ public:
     }
 
 private:
+    // Records what a statement that failed to parse may have declared.
+    void dropped(size_t start) {
+        ++ast_.dropped;
+        const Token& a = t_[start];
+        const Token& b = start + 1 < t_.size() ? t_[start + 1] : t_.back();
+        const Token& c = start + 2 < t_.size() ? t_[start + 2] : t_.back();
+        if ((a.kind == Tok::Ident || a.kind == Tok::Number) && b.kind == Tok::Colon) {
+            if (c.kind == Tok::Ident) ast_.droppedNames.push_back(static_cast<uint32_t>(start + 2));
+            if (a.kind == Tok::Ident) ast_.droppedAxiom = true;  // maybe `w: S(6)`
+        } else if (a.kind == Tok::Ident && !isCsgOperator(b.kind)) {
+            ast_.droppedNames.push_back(static_cast<uint32_t>(start));  // definition or module
+            if (b.kind == Tok::LParen) ast_.droppedAxiom = true;
+        } else if (a.isKw(Kw::Material) && b.kind == Tok::Ident) {
+            ast_.droppedNames.push_back(static_cast<uint32_t>(start + 1));
+        } else if (!(a.kind == Tok::Keyword && isDirective(a.kw))) {
+            ast_.droppedAxiom = true;
+        }
+    }
+
     // --- tokens ---
     const Token& tok(size_t k = 0) const {
         const size_t i = p_ + k;
