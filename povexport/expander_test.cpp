@@ -17,6 +17,13 @@ using namespace testgraphs;
 
 uint64_t pow4(int n) { return uint64_t{1} << (2 * n); }
 
+ExpandOptions budget(uint64_t maxNodes, uint64_t countVisits = 0) {
+    ExpandOptions o;
+    o.maxNodes = maxNodes;
+    o.countVisits = countVisits;
+    return o;
+}
+
 TEST(Expander, SierpinskiOrderNHasFourToTheNTetrahedra) {
     for (int n = 0; n <= 5; ++n) {
         const Graph g = sierpinski(n);
@@ -115,7 +122,7 @@ TEST(Expander, BudgetErrorSaysHowManyNodesItWouldNeed) {
     const Graph g = sierpinski(8);
     const uint64_t need = pow4(8) + (pow4(8) - 1) / 3;
     try {
-        expand(g, {.maxNodes = 1000});
+        expand(g, budget(1000));
         FAIL() << "no budget error";
     } catch (const BudgetError& e) {
         EXPECT_EQ(e.limit, 1000u);
@@ -125,10 +132,10 @@ TEST(Expander, BudgetErrorSaysHowManyNodesItWouldNeed) {
         EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
     }
     // Exactly at the budget it fits.
-    EXPECT_EQ(expand(g, {.maxNodes = need}).nodes.size(), need);
+    EXPECT_EQ(expand(g, budget(need)).nodes.size(), need);
     // When the counting pass gives up, the builder's own check stops the expansion.
     try {
-        expand(g, {.maxNodes = 1000, .countVisits = 10});
+        expand(g, budget(1000, 10));
         FAIL() << "no budget error";
     } catch (const BudgetError& e) {
         EXPECT_FALSE(e.needed.has_value());
@@ -137,7 +144,7 @@ TEST(Expander, BudgetErrorSaysHowManyNodesItWouldNeed) {
 }
 
 TEST(Expander, CountStopsAtItsWorkLimit) {
-    const ExpansionCount c = countExpansion(stochastic(12), {.maxVisits = 50});
+    const ExpansionCount c = countExpansion(stochastic(12), CountOptions{50});
     EXPECT_FALSE(c.complete);
     EXPECT_LE(c.visits, 51u);
 }

@@ -1,0 +1,547 @@
+// The POV-Ray 3.7 writer: see pov_writer.h for the mapping.
+#include "pov_writer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <stdexcept>
+#include <string_view>
+
+#include <fmt/format.h>
+
+namespace pcsg {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// Geometry of the primitives in world coordinates.
+
+double rowNorm2(const Affine& m, int i) {
+    return m.l[i][0] * m.l[i][0] + m.l[i][1] * m.l[i][1] + m.l[i][2] * m.l[i][2];
+}
+double rowNormXY(const Affine& m, int i) {
+    return std::sqrt(m.l[i][0] * m.l[i][0] + m.l[i][1] * m.l[i][1]);
+}
+
+// The image of the disk of radius 1 about the z axis in the plane z = h.
+Box diskBox(const Affine& m, double h) {
+    const Vec3 c = m.point({0, 0, h});
+    Box b;
+    for (int i = 0; i < 3; ++i) {
+        const double e = rowNormXY(m, i);
+        b.lo[i] = c[i] - e;
+        b.hi[i] = c[i] + e;
+    }
+    return b;
+}
+
+void triangleCorners(const ExpandedTree& t, const TreePrimitive& p, Vec3 out[3]) {
+    switch (p.kind) {
+        case PrimitiveKind::Tri1:
+            out[0] = {0, 0, 0}, out[1] = {1, 0, 0}, out[2] = {0, 1, 0};
+            break;
+        case PrimitiveKind::Tri2:
+            out[0] = {0, 0, 0}, out[1] = {-1, 0, 0}, out[2] = {0, -1, 0};
+            break;
+        default: {
+            const double* a = t.args.data() + p.firstArg;
+            for (int k = 0; k < 3; ++k) out[k] = {a[3 * k], a[3 * k + 1], a[3 * k + 2]};
+        }
+    }
+    for (int k = 0; k < 3; ++k) out[k] = p.toWorld.point(out[k]);
+}
+
+constexpr Vec3 kTetraVertices[4] = {{1, 1, 1}, {-1, -1, 1}, {1, -1, -1}, {-1, 1, -1}};
+
+// A box that holds the primitive (tight for everything but the plane, which is infinite).
+Box primitiveBox(const ExpandedTree& t, const TreePrimitive& p) {
+    const Affine& m = p.toWorld;
+    Box b;
+    switch (p.kind) {
+        case PrimitiveKind::Sphere:
+            for (int i = 0; i < 3; ++i) {
+                const double e = std::sqrt(rowNorm2(m, i));
+                b.lo[i] = m.t[i] - e;
+                b.hi[i] = m.t[i] + e;
+            }
+            return b;
+        case PrimitiveKind::Cube: return transformBox(m, Box{{-1, -1, -1}, {1, 1, 1}});
+        case PrimitiveKind::Tetrahedron:
+            for (const Vec3& v : kTetraVertices) b.extend(m.point(v));
+            return b;
+        case PrimitiveKind::Cylinder: return unite(diskBox(m, 0), diskBox(m, 1));
+        case PrimitiveKind::Cone: {
+            b = diskBox(m, 0);
+            b.extend(m.point({0, 0, 1}));
+            return b;
+        }
+        case PrimitiveKind::Torus: {
+            // Inside the sum of the circle of radius R and the ball of radius r.
+            const double R = std::fabs(t.args[p.firstArg]), r = std::fabs(t.args[p.firstArg + 1]);
+            for (int i = 0; i < 3; ++i) {
+                const double e = R * rowNormXY(m, i) + r * std::sqrt(rowNorm2(m, i));
+                b.lo[i] = m.t[i] - e;
+                b.hi[i] = m.t[i] + e;
+            }
+            return b;
+        }
+        case PrimitiveKind::Plane: {
+            constexpr double inf = Box::inf;
+            return transformBox(m, Box{{-inf, -inf, -inf}, {inf, inf, 0}});
+        }
+        case PrimitiveKind::Tri1:
+        case PrimitiveKind::Tri2:
+        case PrimitiveKind::Triangle: {
+            Vec3 c[3];
+            triangleCorners(t, p, c);
+            for (const Vec3& v : c) b.extend(v);
+            return b;
+        }
+        case PrimitiveKind::Empty: return b;
+    }
+    return b;
+}
+
+// POV-Ray rejects a triangle whose cross product (P1-P2) x (P3-P2) has length 0 (with a
+// warning). Slivers that thin are invisible: leave them out with some margin.
+bool degenerate(const Vec3 c[3]) {
+    const Vec3 a = c[0] - c[1], b = c[2] - c[1];
+    const double n = length(cross(a, b));
+    return !(n > 1e-14 * length(a) * length(b)) || !std::isfinite(n);
+}
+
+// The boxes of all nodes: children precede parents, so one forward pass.
+std::vector<Box> nodeBoxes(const ExpandedTree& t) {
+    std::vector<Box> boxes(t.nodes.size());
+    for (uint32_t n = 0; n < t.nodes.size(); ++n) {
+        const TreeNode& node = t.nodes[n];
+        switch (node.kind) {
+            case TreeKind::Primitive: boxes[n] = primitiveBox(t, t.primitiveOf(n)); break;
+            case TreeKind::Union: {
+                Box b;
+                for (uint32_t i = 0; i < node.count; ++i) b.extend(boxes[t.childrenOf(n)[i]]);
+                boxes[n] = b;
+                break;
+            }
+            case TreeKind::Intersection: {
+                Box b = Box::everything();
+                for (uint32_t i = 0; i < node.count; ++i) b = intersect(b, boxes[t.childrenOf(n)[i]]);
+                boxes[n] = b;
+                break;
+            }
+            case TreeKind::Difference: boxes[n] = boxes[t.childrenOf(n)[0]]; break;
+        }
+    }
+    return boxes;
+}
+
+// ---------------------------------------------------------------------------------------
+// Text.
+
+// Streams text through a buffer of bounded size.
+class Out {
+public:
+    explicit Out(std::ostream& os) : os_(os) {}
+    ~Out() = default;
+
+    template <class... Args>
+    void put(fmt::format_string<Args...> f, Args&&... args) {
+        fmt::format_to(std::back_inserter(buf_), f, std::forward<Args>(args)...);
+        if (buf_.size() > (1 << 16)) flush();
+    }
+    void raw(std::string_view s) {
+        buf_.append(s.data(), s.data() + s.size());
+        if (buf_.size() > (1 << 16)) flush();
+    }
+    void num(double v) {
+        if (v == 0) v = 0;  // no "-0"
+        fmt::format_to(std::back_inserter(buf_), "{}", v);
+    }
+    void vec(const Vec3& v) {
+        buf_.push_back('<');
+        num(v.x);
+        buf_.push_back(',');
+        num(v.y);
+        buf_.push_back(',');
+        num(v.z);
+        buf_.push_back('>');
+    }
+    void flush() {
+        os_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+        written_ += buf_.size();
+        buf_.clear();
+        if (!os_) throw std::runtime_error("could not write the POV-Ray file");
+    }
+    uint64_t written() const { return written_ + buf_.size(); }
+
+private:
+    std::ostream& os_;
+    fmt::memory_buffer buf_;
+    uint64_t written_ = 0;
+};
+
+// POV-Ray's matrix is p·M + t: the 3x3 part is L transposed, row by row.
+void putMatrix(Out& o, const Affine& m) {
+    o.put(" matrix<");
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) {
+            o.num(m.l[i][j]);
+            o.put(",");
+        }
+    o.num(m.t.x);
+    o.put(",");
+    o.num(m.t.y);
+    o.put(",");
+    o.num(m.t.z);
+    o.put(">");
+}
+
+// The bounding box written with a little margin: POV-Ray's box tests have tolerances,
+// and a flat object (a triangle in a coordinate plane) would otherwise get a box of no
+// thickness.
+void putBound(Out& o, const Box& b) {
+    double extent = 0;
+    for (int i = 0; i < 3; ++i) extent = std::max(extent, b.hi[i] - b.lo[i]);
+    const double pad = 1e-6 * extent + 1e-9;
+    o.raw(" bounded_by{box{");
+    o.vec(b.lo - Vec3(pad, pad, pad));
+    o.raw(",");
+    o.vec(b.hi + Vec3(pad, pad, pad));
+    o.raw("}}");
+}
+
+bool boundable(const Box& b) {
+    if (!b.isBounded()) return false;
+    for (int i = 0; i < 3; ++i)
+        if (!(std::fabs(b.lo[i]) < 1e300 && std::fabs(b.hi[i]) < 1e300)) return false;
+    return true;
+}
+
+std::string commentSafe(const std::string& s) {
+    std::string out;
+    for (char c : s) out += (std::isalnum(static_cast<unsigned char>(c)) || c == '_') ? c : '_';
+    return out;
+}
+
+void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& opt) {
+    o.put("// POV-Ray 3.7 scene exported by pcsg export-pov{}{}\n",
+          opt.title.empty() ? "" : " from ", opt.title);
+    o.put("// expanded tree: {} primitives, {} nodes\n", t.primitives.size(), t.nodes.size());
+    o.put("// render: povray +I<file> +W{} +H{} (the camera's aspect is {}:{})\n", opt.width,
+          opt.height, opt.width, opt.height);
+    o.put("#version 3.7;\n");
+    o.put("global_settings {{ assumed_gamma 1.0 max_trace_level 5 }}\n\n");
+    o.put("{}\n", povCamera(g.scene.camera, opt.width, opt.height));
+    for (const Light& l : g.scene.lights) {
+        o.put("light_source {{ ");
+        o.vec(l.position);
+        o.put(" color rgb ");
+        o.vec(l.color);
+        o.put(" }}\n");
+    }
+    o.put("background {{ color rgb ");
+    o.vec(g.scene.background);
+    o.put(" }}\n\n");
+
+    // Materials: materials[0] is the default (white, POV-Ray's finish defaults).
+    const size_t count = std::max<size_t>(g.materials.size(), 1);
+    for (size_t i = 0; i < count; ++i) {
+        const Material m = i < g.materials.size() ? g.materials[i] : Material{};
+        o.put("#declare M{} = texture {{ pigment {{ color rgb ", i);
+        o.vec(m.color);
+        o.put(" }} finish {{ ambient ");
+        o.num(m.ambient);
+        o.put(" diffuse ");
+        o.num(m.diffuse);
+        o.put(" phong ");
+        o.num(m.phong);
+        o.put(" phong_size ");
+        o.num(m.phongSize);
+        o.put(" reflection ");
+        o.num(m.reflection);
+        o.put(" }} }}");
+        if (!m.name.empty()) o.put("  // {}", commentSafe(m.name));
+        o.put("\n");
+    }
+
+    // The tetrahedron with vertices (1,1,1), (-1,-1,1), (1,-1,-1), (-1,1,-1): the face
+    // opposite vertex v lies in the plane -v.p = 1, its inside is -v.p <= 1.
+    bool tetra = false;
+    for (const TreePrimitive& p : t.primitives) tetra = tetra || p.kind == PrimitiveKind::Tetrahedron;
+    if (tetra) {
+        const double s = 1 / std::sqrt(3.0);
+        o.put("\n#declare PcsgTetrahedron = intersection {{\n");
+        for (const Vec3& v : kTetraVertices) {
+            o.put("  plane {{ ");
+            o.vec(-v * s);
+            o.put(", ");
+            o.num(s);
+            o.put(" }}\n");
+        }
+        o.put("  bounded_by {{ box {{ <-1.000001,-1.000001,-1.000001>, <1.000001,1.000001,1.000001> }} }}\n}}\n");
+    }
+    o.put("\n");
+}
+
+// The rotation taking POV-Ray's torus (about y, in y = 0) to ours (about z, in z = 0):
+// x -> x, y -> z, z -> -y.
+Affine torusFrame() {
+    Affine r;
+    r.l[0][0] = 1, r.l[0][1] = 0, r.l[0][2] = 0;
+    r.l[1][0] = 0, r.l[1][1] = 0, r.l[1][2] = -1;
+    r.l[2][0] = 0, r.l[2][1] = 1, r.l[2][2] = 0;
+    return r;
+}
+
+// One primitive on one line. Returns false when it was left out.
+bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, const std::string& indent) {
+    const auto tex = [&] { o.put(" texture{{M{}}}", p.material); };
+    switch (p.kind) {
+        case PrimitiveKind::Sphere:
+            o.put("{}sphere{{<0,0,0>,1", indent);
+            tex();
+            putMatrix(o, p.toWorld);
+            break;
+        case PrimitiveKind::Cube:
+            o.put("{}box{{<-1,-1,-1>,<1,1,1>", indent);
+            tex();
+            putMatrix(o, p.toWorld);
+            break;
+        case PrimitiveKind::Cylinder:
+            o.put("{}cylinder{{<0,0,0>,<0,0,1>,1", indent);
+            tex();
+            putMatrix(o, p.toWorld);
+            break;
+        case PrimitiveKind::Cone:
+            o.put("{}cone{{<0,0,0>,1,<0,0,1>,0", indent);
+            tex();
+            putMatrix(o, p.toWorld);
+            break;
+        case PrimitiveKind::Tetrahedron:
+            o.put("{}object{{PcsgTetrahedron", indent);
+            tex();
+            putMatrix(o, p.toWorld);
+            break;
+        case PrimitiveKind::Torus:
+            o.put("{}torus{{", indent);
+            o.num(t.args[p.firstArg]);
+            o.put(",");
+            o.num(t.args[p.firstArg + 1]);
+            tex();
+            putMatrix(o, p.toWorld * torusFrame());
+            break;
+        case PrimitiveKind::Plane:
+            o.put("{}plane{{<0,0,1>,0", indent);
+            tex();
+            putMatrix(o, p.toWorld);
+            break;
+        case PrimitiveKind::Tri1:
+        case PrimitiveKind::Tri2:
+        case PrimitiveKind::Triangle: {
+            Vec3 c[3];
+            triangleCorners(t, p, c);
+            if (degenerate(c)) return false;
+            o.put("{}triangle{{", indent);
+            o.vec(c[0]);
+            o.put(",");
+            o.vec(c[1]);
+            o.put(",");
+            o.vec(c[2]);
+            tex();
+            break;
+        }
+        case PrimitiveKind::Empty: return false;
+    }
+    o.put("}}\n");
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------
+// The tree, with an explicit stack. An item is a tree node, or a group: a run of a big
+// union's operands (in `members`) written as a nested union.
+
+struct Item {
+    bool group = false;
+    uint32_t node = 0;       // a tree node
+    size_t lo = 0, hi = 0;   // a group: members[lo, hi)
+    uint32_t next = 0;       // children written so far
+    std::vector<std::pair<size_t, size_t>> slices;  // a big group's sub-groups
+    bool ownsMembers = false;  // this item pushed members[lo, hi) and pops them at the end
+    Box box;
+};
+
+class TreeWriter {
+public:
+    TreeWriter(Out& o, const ExpandedTree& t, const PovOptions& opt, PovWriteStats& stats)
+        : o_(o), t_(t), opt_(opt), stats_(stats), boxes_(nodeBoxes(t)),
+          maxChildren_(std::max<uint32_t>(opt.maxUnionChildren, 2)) {}
+
+    void write(uint32_t root) {
+        stack_.push_back(nodeItem(root));
+        while (!stack_.empty()) step();
+    }
+
+private:
+    Item nodeItem(uint32_t n) {
+        Item it;
+        it.node = n;
+        return it;
+    }
+
+    std::string indent() const { return std::string(std::min<size_t>(stack_.size() - 1, 40) * 1, ' '); }
+
+    void step() {
+        Item& it = stack_.back();
+        if (!it.group) {
+            const TreeNode& node = t_.nodes[it.node];
+            if (node.kind == TreeKind::Primitive) {
+                if (putPrimitive(o_, t_, t_.primitiveOf(it.node), indent()))
+                    ++stats_.objects;
+                else
+                    ++stats_.skipped;
+                stack_.pop_back();
+                return;
+            }
+            if (node.kind == TreeKind::Union && node.count > maxChildren_) {
+                // Regroup: the operands become a group item over a run of `members`.
+                const uint32_t n = it.node;
+                const size_t lo = members_.size();
+                members_.insert(members_.end(), t_.childrenOf(n), t_.childrenOf(n) + node.count);
+                stack_.pop_back();
+                Item g;
+                g.group = true;
+                g.lo = lo;
+                g.hi = members_.size();
+                g.ownsMembers = true;
+                stack_.push_back(std::move(g));
+                return;
+            }
+            if (it.next == 0) {
+                const char* name = node.kind == TreeKind::Union          ? "union"
+                                   : node.kind == TreeKind::Intersection ? "intersection"
+                                                                         : "difference";
+                o_.put("{}{} {{\n", indent(), name);
+            }
+            if (it.next < node.count) {
+                const uint32_t c = t_.childrenOf(it.node)[it.next++];
+                stack_.push_back(nodeItem(c));
+                return;
+            }
+            const Box& b = boxes_[it.node];
+            const bool bound = node.kind != TreeKind::Union || opt_.boundUnions;
+            o_.put("{}", indent());
+            if (bound && boundable(b)) putBound(o_, b);
+            o_.put(" }}\n");
+            stack_.pop_back();
+            return;
+        }
+
+        // A group of members[lo, hi).
+        const size_t n = it.hi - it.lo;
+        if (it.next == 0) {
+            if (n == 1) {
+                const uint32_t only = members_[it.lo];
+                finishGroup();
+                stack_.push_back(nodeItem(only));
+                return;
+            }
+            for (size_t i = it.lo; i < it.hi; ++i) it.box.extend(boxes_[members_[i]]);
+            if (n > maxChildren_) split(it);
+            o_.put("{}union {{\n", indent());
+            ++stats_.groups;
+        }
+        const size_t parts = it.slices.empty() ? n : it.slices.size();
+        if (it.next < parts) {
+            const uint32_t i = it.next++;
+            if (it.slices.empty()) {
+                stack_.push_back(nodeItem(members_[it.lo + i]));
+            } else {
+                Item g;
+                g.group = true;
+                g.lo = it.slices[i].first;
+                g.hi = it.slices[i].second;
+                stack_.push_back(std::move(g));
+            }
+            return;
+        }
+        o_.put("{}", indent());
+        if (opt_.boundUnions && boundable(it.box)) putBound(o_, it.box);
+        o_.put(" }}\n");
+        finishGroup();
+    }
+
+    void finishGroup() {
+        Item& it = stack_.back();
+        if (it.ownsMembers) members_.resize(it.lo);
+        stack_.pop_back();
+    }
+
+    // Sorts members[lo, hi) by box centre along the axis where the centres spread most,
+    // and cuts them into at most maxChildren_ runs of equal size.
+    void split(Item& it) {
+        Box centres;
+        for (size_t i = it.lo; i < it.hi; ++i) centres.extend(centreOf(members_[i]));
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+            if (centres.hi[a] - centres.lo[a] > centres.hi[axis] - centres.lo[axis]) axis = a;
+        std::stable_sort(members_.begin() + static_cast<std::ptrdiff_t>(it.lo),
+                         members_.begin() + static_cast<std::ptrdiff_t>(it.hi),
+                         [&](uint32_t a, uint32_t b) { return centreOf(a)[axis] < centreOf(b)[axis]; });
+        const size_t n = it.hi - it.lo;
+        const size_t parts = std::min<size_t>(maxChildren_, (n + maxChildren_ - 1) / maxChildren_);
+        const size_t size = (n + parts - 1) / parts;
+        for (size_t s = it.lo; s < it.hi; s += size) it.slices.push_back({s, std::min(it.hi, s + size)});
+    }
+
+    Vec3 centreOf(uint32_t n) const {
+        const Box& b = boxes_[n];
+        Vec3 c;
+        for (int i = 0; i < 3; ++i) {
+            // Unbounded operands (planes) sort by their finite side, or as 0.
+            const double lo = std::isfinite(b.lo[i]) ? b.lo[i] : (std::isfinite(b.hi[i]) ? b.hi[i] : 0);
+            const double hi = std::isfinite(b.hi[i]) ? b.hi[i] : lo;
+            c[i] = b.isEmpty() ? 0 : 0.5 * (lo + hi);
+        }
+        return c;
+    }
+
+    Out& o_;
+    const ExpandedTree& t_;
+    const PovOptions& opt_;
+    PovWriteStats& stats_;
+    std::vector<Box> boxes_;
+    uint32_t maxChildren_;
+    std::vector<Item> stack_;
+    std::vector<uint32_t> members_;
+};
+
+}  // namespace
+
+std::string povCamera(const Camera& c, int width, int height) {
+    const double aspect = static_cast<double>(width > 0 ? width : 4) / (height > 0 ? height : 3);
+    return fmt::format(
+        "camera {{\n  perspective\n  location <{},{},{}>\n  right -x*{}\n  angle {}\n"
+        "  sky <{},{},{}>\n  look_at <{},{},{}>\n}}",
+        c.location.x, c.location.y, c.location.z, aspect, c.angle, c.sky.x, c.sky.y, c.sky.z,
+        c.lookAt.x, c.lookAt.y, c.lookAt.z);
+}
+
+PovWriteStats writePov(const Graph& g, const ExpandedTree& tree, std::ostream& out,
+                       const PovOptions& options) {
+    PovWriteStats stats;
+    Out o(out);
+    putHeader(o, g, tree, options);
+    if (!tree.empty()) {
+        TreeWriter w(o, tree, options, stats);
+        w.write(tree.root);
+    } else {
+        o.put("// the scene expands to nothing\n");
+    }
+    o.flush();
+    out.flush();
+    if (!out) throw std::runtime_error("could not write the POV-Ray file");
+    stats.bytes = o.written();
+    return stats;
+}
+
+}  // namespace pcsg
