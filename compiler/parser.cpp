@@ -482,6 +482,8 @@ private:
             expect(Tok::RParen, "')'");
             return inner;
         }
+        if (t.kind == Tok::Keyword && !isFunction(t.kw) && t.kw != Kw::Paint)
+            fail(p_, fmt::format("'{}' is a keyword and cannot name a module or definition", text(pos())));
         std::string hint;
         if (t.kind == Tok::Newline || t.kind == Tok::End || t.kind == Tok::Semicolon)
             hint = " (an operator at the end of a line continues the statement; a prefix needs its operand)";
