@@ -122,9 +122,9 @@ struct Ast {
 
     // What syntax errors left out, so that the builder does not report their echoes:
     // the names that a dropped statement may have declared or defined (token indices),
-    // whether a dropped statement may have been the axiom, and how many were dropped.
+    // and how many statements were dropped (any of them may have been the axiom or have
+    // assigned a parameter).
     std::vector<uint32_t> droppedNames;
-    bool droppedAxiom = false;
     uint32_t dropped = 0;
 };
 

@@ -505,7 +505,7 @@ private:
             error(s.tok, fmt::format("a second axiom (the first is at line {}): a file has exactly one",
                                      line(axiom_->tok)));
         }
-        if (!axiom_ && !ast_.droppedAxiom)
+        if (!axiom_ && ast_.dropped == 0)
             diags_.error(FileLoc{src_.file(), 1, 1},
                          "the file has no axiom: a statement that is the object itself, such as "
                          "'{c = 6} S' or 'w: S(6)'");

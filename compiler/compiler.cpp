@@ -25,6 +25,7 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
     }
     const Source src(text, file);
     const TokenStream tokens = lex(src, diags);
+    if (!tokens.complete) return std::nullopt;  // the rest of the file was not read
     if (diags.errors().size() == errorsBefore && tokens.tokens.size() == 1) {
         diags.error(FileLoc{file, 1, 1}, "the file is empty: a scene needs at least an axiom, "
                                          "such as 'sphere'");

@@ -183,6 +183,7 @@ public:
                 const size_t close = s_.find("*/", i + 2);
                 if (close == std::string_view::npos) {
                     error(i, "unterminated /* comment");
+                    stop_ = true;
                     return;
                 }
                 // A comment spanning lines still separates the tokens around it by a line
@@ -207,6 +208,8 @@ public:
             if (stop_ || full(diags_)) return;
         }
     }
+
+    bool stopped() const { return stop_ || full(diags_); }
 
 private:
     void error(size_t offset, std::string message) {
@@ -280,7 +283,7 @@ private:
             case '%': push(Tok::Percent, i, 1); return i + 1;
             case '^': push(Tok::Caret, i, 1); return i + 1;
             case '\\': push(Tok::Difference, i, 1); return i + 1;
-            case '#': push(Tok::Hash, i, 1); return i + 1;
+            case '#': return hash(i);
             case '-':
                 if (d == '>') {
                     push(Tok::Arrow, i, 2);
@@ -348,6 +351,22 @@ private:
         else
             error(i, fmt::format("unexpected control character 0x{:02X}", u));
         return j;
+    }
+
+    // '#': a directive. Only #define exists; the line of any other is skipped here (the
+    // expander reports it), so that `#include "x"` gets one error, not one per quote.
+    size_t hash(size_t i) {
+        const size_t n = s_.size();
+        const bool first = lineStart_;
+        push(Tok::Hash, i, 1);
+        size_t j = i + 1;
+        while (j < n && (s_[j] == ' ' || s_[j] == '\t')) ++j;
+        size_t k = j;
+        while (k < n && isIdentChar(static_cast<unsigned char>(s_[k]))) ++k;
+        if (!first || k == j || s_.substr(j, k - j) == "define") return i + 1;
+        push(Tok::Ident, j, k - j);
+        const void* nl = std::memchr(s_.data() + k, '\n', n - k);
+        return nl ? static_cast<size_t>(static_cast<const char*>(nl) - s_.data()) : n;
     }
 
     static bool badAscii(unsigned char c) {
@@ -430,6 +449,10 @@ public:
         }
         out_.push_back(raw_.back());
     }
+
+private:
+public:
+    bool stopped() const { return stop_; }
 
 private:
     struct Macro {
@@ -595,11 +618,9 @@ private:
 
     // Expands one use of a macro, iteratively (a chain of macros never deepens the stack).
     void use(uint32_t index, const Token& at, bool lineStart) {
-        if (!usable(index, at)) {
-            Token t = at;
-            emit(t);
-            return;
-        }
+        // A macro that cannot expand here is reported and dropped: leaving its name
+        // would only add echoes ("unknown module ...") of the same error.
+        if (!usable(index, at)) return;
         frames_.clear();
         push(index, lineStart);
         while (!frames_.empty() && !stop_) {
@@ -618,8 +639,8 @@ private:
             t.flags = static_cast<uint8_t>((t.flags & ~kLineStart) | (ls ? kLineStart : 0));
             t.origin = f.origin;
             const uint32_t inner = macroAt_[rawIndex];
-            if (inner != kNotMacro && usable(inner, t)) {
-                push(inner, ls);  // invalidates f
+            if (inner != kNotMacro) {
+                if (usable(inner, t)) push(inner, ls);  // invalidates f
                 continue;
             }
             emit(t);
@@ -755,7 +776,8 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
 TokenStream lex(const Source& src, Diagnostics& diags) {
     std::vector<Token> raw;
     raw.reserve(src.text().size() / 4 + 16);
-    Scanner(src, diags, raw).run();
+    Scanner scanner(src, diags, raw);
+    scanner.run();
     Token end;
     end.kind = Tok::End;
     end.flags = kLineStart;
@@ -763,11 +785,13 @@ TokenStream lex(const Source& src, Diagnostics& diags) {
     raw.push_back(end);
 
     std::vector<Token> expanded;
-    Expander(src, diags, raw, expanded).run();
+    Expander expander(src, diags, raw, expanded);
+    expander.run();
     raw.clear();
     raw.shrink_to_fit();
 
     TokenStream ts;
+    ts.complete = !scanner.stopped() && !expander.stopped();
     applyNewlineRule(expanded, ts.tokens);
     return ts;
 }

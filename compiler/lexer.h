@@ -96,6 +96,9 @@ struct Token {
 
 struct TokenStream {
     std::vector<Token> tokens;  // always ends with Tok::End
+    // False when lexing stopped early (a NUL byte, an unterminated comment or #define
+    // block, a runaway expansion): the tokens are then only a prefix of the file.
+    bool complete = true;
 };
 
 // Lexes and expands `src`. Errors go to `diags`; the stream is usable (ends with End)

@@ -83,6 +83,7 @@ public:
             }
             if (diags_.errors().size() >= Diagnostics::kMaxErrors) break;
             const size_t start = p_;
+            const size_t statements = ast_.stmts.size();
             try {
                 depth_ = 0;
                 assignIsEq_ = false;
@@ -90,8 +91,8 @@ public:
                 if (!at(Tok::Newline) && !at(Tok::Semicolon) && !at(Tok::End))
                     fail(p_, fmt::format("expected the end of the statement, found {}", describe(src_, tok())));
             } catch (const Abort&) {
-                // Panic mode: the statement is dropped (statements are added only once
-                // parsed); resume after its end.
+                // Panic mode: drop the statement, resume after its end.
+                ast_.stmts.resize(statements);
                 dropped(start);
                 while (!at(Tok::End) && !((at(Tok::Newline) || at(Tok::Semicolon)) && (tok().flags & kTopLevel)))
                     ++p_;
@@ -109,14 +110,10 @@ private:
         const Token& c = start + 2 < t_.size() ? t_[start + 2] : t_.back();
         if ((a.kind == Tok::Ident || a.kind == Tok::Number) && b.kind == Tok::Colon) {
             if (c.kind == Tok::Ident) ast_.droppedNames.push_back(static_cast<uint32_t>(start + 2));
-            if (a.kind == Tok::Ident) ast_.droppedAxiom = true;  // maybe `w: S(6)`
         } else if (a.kind == Tok::Ident && !isCsgOperator(b.kind)) {
             ast_.droppedNames.push_back(static_cast<uint32_t>(start));  // definition or module
-            if (b.kind == Tok::LParen) ast_.droppedAxiom = true;
         } else if (a.isKw(Kw::Material) && b.kind == Tok::Ident) {
             ast_.droppedNames.push_back(static_cast<uint32_t>(start + 1));
-        } else if (!(a.kind == Tok::Keyword && isDirective(a.kw))) {
-            ast_.droppedAxiom = true;
         }
     }
 
