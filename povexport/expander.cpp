@@ -246,6 +246,7 @@ private:
 struct SelectInfo {
     bool memoisable = false;
     std::vector<Slot> reads;  // the slots any expression below reads, ascending
+    uint64_t lookups = 0, hits = 0;
 };
 
 void exprInfo(const Graph& g, ExprId id, bool& usesPath, std::vector<uint8_t>& readSet) {
@@ -349,13 +350,16 @@ Count plus(Count a, const Count& b) {
 struct StopCounting {};
 
 struct KeyHash {
+    // SplitMix64's finaliser per word: parameter values are often dyadic fractions whose
+    // low bits are all zero, which a multiplicative hash alone would not spread.
+    static uint64_t mix(uint64_t z) {
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        return z ^ (z >> 31);
+    }
     size_t operator()(const std::vector<uint64_t>& k) const {
         uint64_t h = 0x84222325cbf29ce4ULL;
-        for (uint64_t v : k) {
-            h ^= v;
-            h *= 0x100000001b3ULL;
-            h ^= h >> 29;
-        }
+        for (uint64_t v : k) h = mix(h ^ v);
         return static_cast<size_t>(h);
     }
 };
@@ -377,8 +381,13 @@ public:
 
     bool lookup(NodeId n, uint32_t depth, const double* frame, Count& out) {
         if (!makeKey(n, depth, frame)) return false;
+        SelectInfo& s = selects_[g_.nodes[n].payload];
+        // A module whose parameter frames never repeat (a terrain's coordinates) is not
+        // worth the hashing: stop memoising it when hardly anything was found.
+        if (++s.lookups == 4096 && s.hits * 64 < s.lookups) s.memoisable = false;
         const auto it = memo_.find(key_);
         if (it == memo_.end()) return false;
+        ++s.hits;
         out = it->second;
         return true;
     }

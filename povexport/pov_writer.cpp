@@ -520,10 +520,10 @@ private:
 std::string povCamera(const Camera& c, int width, int height) {
     const double aspect = static_cast<double>(width > 0 ? width : 4) / (height > 0 ? height : 3);
     return fmt::format(
-        "camera {{\n  perspective\n  location <{},{},{}>\n  right -x*{}\n  angle {}\n"
-        "  sky <{},{},{}>\n  look_at <{},{},{}>\n}}",
-        c.location.x, c.location.y, c.location.z, aspect, c.angle, c.sky.x, c.sky.y, c.sky.z,
-        c.lookAt.x, c.lookAt.y, c.lookAt.z);
+        "camera {{\n  perspective\n  location <{},{},{}>\n  right -x*{}\n  up y\n  direction z\n"
+        "  sky <{},{},{}>\n  look_at <{},{},{}>\n  angle {}\n}}",
+        c.location.x, c.location.y, c.location.z, aspect, c.sky.x, c.sky.y, c.sky.z, c.lookAt.x,
+        c.lookAt.y, c.lookAt.z, c.angle);
 }
 
 PovWriteStats writePov(const Graph& g, const ExpandedTree& tree, std::ostream& out,

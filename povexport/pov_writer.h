@@ -31,20 +31,17 @@
 //
 // The camera (right-handed scene, left-handed POV-Ray): the geometry is not mirrored;
 // the camera's `right` vector is negated, which makes POV-Ray's look_at build a
-// right-handed frame (its handedness test is (up x direction) . right < 0 with the
-// default up <0,1,0> and direction <0,0,1>):
+// right-handed frame (its handedness test is (up x direction) . right < 0). The block is
+// exactly the one tracer/camera.h documents and reproduces:
 //
-//   camera { perspective location <L> right -x*W/H angle A sky <S> look_at <P> }
+//   camera { perspective location <L> right -x*W/H up y direction z sky <S>
+//            look_at <P> angle A }
 //
-// (in this order: angle uses the length of right; look_at must come last). `angle` is
-// the horizontal field of view, the image's aspect the vertical one. With sky <0,0,1>
-// looking along +y, +x is on the right of the image, as LANGUAGE.md section 7 says.
-// The tracer's camera (tracer/camera.h) must match this block: the world direction
-// through pixel centre (i, j) of a W x H image is
-//   forward + ((i + 0.5) / W - 0.5) * 2 tan(A/2) * right_n
-//           + (0.5 - (j + 0.5) / H) * 2 tan(A/2) * (H / W) * up_n,
-// with forward = normalize(look_at - location), right_n = normalize(forward x sky),
-// up_n = right_n x forward (row j = 0 at the top of the image).
+// `angle` is the horizontal field of view, the image's aspect the vertical one; POV-Ray
+// applies look_at and angle after the other items. With sky <0,0,1> looking along +y,
+// +x is on the right of the image, as LANGUAGE.md section 7 says (checked against
+// POV-Ray in pov_writer_test.cpp: the silhouettes of asymmetric objects match an
+// independent pin-hole projection).
 #pragma once
 
 #include <cstdint>
