@@ -105,8 +105,9 @@ TEST(Scenes, TerrainsHaveTwoTimesFourToTheNTriangles) {
         const std::string text = readFile(file);
         // The file's own order is counted only where that is quick (terrain's 2^21
         // triangles take seconds: nothing repeats to memoise).
-        if (c.n <= 8)
+        if (c.n <= 8) {
             EXPECT_EQ(countExpansion(compileText(c.scene, text)).primitives, 2 * pow4(c.n) + c.extra) << c.scene;
+        }
         for (int n = 1; n <= 3; ++n) {
             const ExpandedTree t = expand(compileText(c.scene, replaceOnce(text, c.order, fmt::format("cnt = {};", n))));
             EXPECT_EQ(t.primitives.size(), 2 * pow4(n) + c.extra) << c.scene << " order " << n;
