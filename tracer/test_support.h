@@ -1,0 +1,123 @@
+// Helpers shared by the tracer's tests (header-only, so that it stays out of the library):
+// compiling scene text, and a small recursive walker that expands a graph by the one
+// semantics, recording every primitive instance with the nodes on its path.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compiler.h"
+#include "eval.h"
+
+namespace pcsg::tracer::testing {
+
+struct Compiled {
+    std::string text;
+    Diagnostics diags;
+    std::optional<Graph> graph;
+};
+
+inline std::unique_ptr<Compiled> compile(std::string text) {
+    auto c = std::make_unique<Compiled>();
+    c->text = std::move(text);
+    c->graph = compileSource("test.pcsg", c->text, c->diags);
+    if (!c->graph) ADD_FAILURE() << "scene does not compile:\n" << c->diags.format();
+    return c;
+}
+
+// One node on an instance's path: the node, its S-node depth, and the map from the node's
+// frame to the world.
+struct PathNode {
+    NodeId node;
+    uint32_t depth;
+    Affine toWorld;
+    uint32_t childTaken = 0;  // operators: the operand the path continues into
+};
+
+struct Instance {
+    NodeId node;  // the primitive
+    PrimitiveKind kind;
+    std::vector<double> args;
+    Affine toWorld;
+    uint32_t material;
+    std::vector<PathNode> path;
+};
+
+// Expands the graph (recursively: for small test scenes only). Stops after `limit`
+// instances.
+class Expander {
+public:
+    explicit Expander(const Graph& g, size_t limit = 200000) : g_(g), limit_(limit) {}
+
+    std::vector<Instance> run() {
+        std::vector<double> frame(g_.slotCount());
+        initFrame(g_, frame.data());
+        walk(g_.axiom, frame, kRootPath, 0, Affine::identity(), 0);
+        return std::move(out_);
+    }
+
+private:
+    const Graph& g_;
+    size_t limit_;
+    std::vector<Instance> out_;
+    std::vector<PathNode> path_;
+
+    void walk(NodeId n, const std::vector<double>& frame, uint64_t path, uint32_t depth,
+              const Affine& world, uint32_t material) {
+        if (out_.size() >= limit_) return;
+        const Node& node = g_.nodes[n];
+        const EvalState st{frame.data(), path};
+        if (node.kind == NodeKind::Select) ++depth;
+        path_.push_back(PathNode{n, depth, world});
+        switch (node.kind) {
+            case NodeKind::Select: {
+                checkDepth(g_, n, depth, st);
+                const uint32_t r = selectRule(g_, n, st);
+                walk(g_.child(n, r), frame, pathRule(path, r), depth, world, material);
+                break;
+            }
+            case NodeKind::Calc: {
+                std::vector<double> next(g_.slotCount());
+                applyCalc(g_, n, st, next.data());
+                walk(g_.child(n), next, path, depth, world, material);
+                break;
+            }
+            case NodeKind::Transform:
+                walk(g_.child(n), frame, path, depth, world * transformMatrix(g_, n, st), material);
+                break;
+            case NodeKind::Paint: walk(g_.child(n), frame, path, depth, world, node.payload); break;
+            case NodeKind::Union:
+            case NodeKind::Intersection:
+            case NodeKind::Difference:
+                for (uint32_t i = 0; i < node.childCount; ++i) {
+                    path_.back().childTaken = i;
+                    walk(g_.child(n, i), frame, pathChild(path, i), depth, world, material);
+                }
+                break;
+            case NodeKind::Primitive: {
+                const Primitive& p = g_.primitives[node.payload];
+                Instance inst{n, p.kind, {}, world, material, path_};
+                inst.args.resize(p.constant ? p.values.size() : p.argCount);
+                if (!inst.args.empty()) primitiveArgs(g_, n, st, inst.args.data());
+                if (p.kind != PrimitiveKind::Empty) out_.push_back(std::move(inst));
+                break;
+            }
+        }
+        path_.pop_back();
+    }
+};
+
+// A few systems from the paper and beyond, shared by the tests.
+inline const char* kSierpinski = R"(
+{c = 4} S
+S if(c > 0, 2, 1)
+1: S -> tetrahedron
+2: S -> {c = c-1} ( move(0.5,0.5,0.5) uscale(0.5) S ∪ move(-0.5,-0.5,0.5) uscale(0.5) S ∪
+                    move(0.5,-0.5,-0.5) uscale(0.5) S ∪ move(-0.5,0.5,-0.5) uscale(0.5) S )
+)";
+
+}  // namespace pcsg::tracer::testing
