@@ -79,6 +79,7 @@ public:
     std::optional<Graph> run() {
         const size_t errorsBefore = diags_.errors().size();
         g_.files = diags_.fileNames();
+        reserve();
         for (uint32_t tok : ast_.droppedNames) dropped_.insert(text(tok));
         g_.materials.push_back(Material{"default"});
         directives();
@@ -94,6 +95,20 @@ public:
     }
 
 private:
+    // Upper bounds from the AST, so that no array of the graph is copied while it grows.
+    void reserve() {
+        const size_t csg = ast_.csg.size(), exprs = ast_.exprs.size(), lists = ast_.lists.size();
+        g_.nodes.reserve(csg + ast_.stmts.size() + 16);
+        g_.edges.reserve(lists + csg + ast_.stmts.size() + 16);
+        g_.exprs.reserve(exprs + 16);
+        g_.code.reserve(2 * exprs + 3 * ast_.chainItems.size() + 16);
+        g_.args.reserve(lists + 16);
+        g_.assignments.reserve(ast_.assigns.size() + lists + 16);
+        g_.calcs.reserve(csg + 16);
+        g_.transforms.reserve(csg + 16);
+        g_.primitives.reserve(csg + 16);
+    }
+
     // --- helpers ---
     FileLoc loc(uint32_t tok) const { return src_.loc(t_[tok].offset); }
     std::string_view text(uint32_t tok) const { return spelling(src_, t_[tok]); }
@@ -111,7 +126,7 @@ private:
             if (t.kind == Tok::Newline || t.kind == Tok::End) continue;
             if (i > from) {
                 const Token& p = t_[i - 1];
-                if (p.origin != t.origin || p.offset + p.length != t.offset) s += ' ';
+                if (p.offset + p.length != t.offset) s += ' ';
             }
             s += spelling(src_, t);
             if (s.size() > 200) {
@@ -603,7 +618,7 @@ private:
             m.node = g_.addNode(NodeKind::Select, index, std::vector<NodeId>(m.rules.size(), kNone), mod.loc);
             mod.node = m.node;
             for (uint32_t f : m.formals) {
-                m.formalSlots.push_back(g_.slot(std::string(text(f))));
+                m.formalSlots.push_back(slotOf(text(f)));
                 assigned_.insert(text(f));
             }
             mod.formals = m.formalSlots;
@@ -637,6 +652,16 @@ private:
             for (size_t k = 0; k < m.rules.size(); ++k)
                 if (g_.edges[g_.nodes[m.node].firstChild + k] == kNone)
                     g_.edges[g_.nodes[m.node].firstChild + k] = placeholder();
+    }
+
+    // The slot of a parameter (Graph::slot searches linearly: fine for a handful of
+    // names, not for a generated file with thousands).
+    Slot slotOf(std::string_view name) {
+        auto it = slots_.find(name);
+        if (it != slots_.end()) return it->second;
+        const Slot s = g_.slot(std::string(name));
+        slots_.emplace(name, s);
+        return s;
     }
 
     NodeId placeholder() {
@@ -676,7 +701,7 @@ private:
                 for (uint32_t i = 0; i < n.count; ++i) {
                     const Assign& a = ast_.assigns[n.first + i];
                     const ExprId value = compile(a.value);
-                    list.push_back(Assignment{g_.slot(std::string(text(a.nameTok))), value});
+                    list.push_back(Assignment{slotOf(text(a.nameTok)), value});
                 }
                 calc.first = static_cast<uint32_t>(g_.assignments.size());
                 g_.assignments.insert(g_.assignments.end(), list.begin(), list.end());
@@ -885,7 +910,7 @@ private:
                            reportedUnknown_.insert(name).second) {
                     error(n.tok, fmt::format("unknown parameter '{}': no C-node or formal parameter assigns it", name));
                 }
-                emit(Op::Load, g_.slot(std::string(name)));
+                emit(Op::Load, slotOf(name));
                 cg.readsSlot = true;
                 cg.push();
                 return;
@@ -1120,6 +1145,7 @@ private:
     std::unordered_set<std::string_view> assigned_;
     std::unordered_set<std::string_view> reportedUnknown_;
     std::unordered_set<std::string_view> dropped_;
+    std::unordered_map<std::string_view, Slot> slots_;
     const Stmt* axiom_ = nullptr;
     NodeId placeholder_ = kNone;
     bool constantOnly_ = false;

@@ -3,6 +3,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -43,6 +44,12 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
 std::optional<Graph> compileFile(const std::string& path, std::string& storage,
                                  Diagnostics& diags) {
     storage.clear();
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        const uint32_t file = diags.addFile(path, storage);
+        diags.error(FileLoc{file, 0, 0}, "cannot read the file: it is a directory");
+        return std::nullopt;
+    }
     std::ifstream in(path, std::ios::binary);
     auto fail = [&](const std::string& why) -> std::optional<Graph> {
         const uint32_t file = diags.addFile(path, storage);

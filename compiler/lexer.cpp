@@ -431,7 +431,7 @@ public:
     void run() {
         collect();
         const size_t n = raw_.size() - 1;  // the last token is End
-        out_.reserve(n + 1);
+        out_.reserve(n + n / 2 + 16);
         size_t i = 0;
         while (i < n && !stop_) {
             const Token& t = raw_[i];
@@ -465,7 +465,6 @@ private:
     struct Frame {
         uint32_t macro;
         uint32_t pos;
-        uint32_t origin;
         bool lineStart;
     };
 
@@ -637,7 +636,6 @@ private:
             ++f.pos;
             const bool ls = first ? f.lineStart : (t.flags & kLineStart) != 0;
             t.flags = static_cast<uint8_t>((t.flags & ~kLineStart) | (ls ? kLineStart : 0));
-            t.origin = f.origin;
             const uint32_t inner = macroAt_[rawIndex];
             if (inner != kNotMacro) {
                 if (usable(inner, t)) push(inner, ls);  // invalidates f
@@ -668,7 +666,7 @@ private:
 
     void push(uint32_t index, bool lineStart) {
         active_[index] = 1;
-        frames_.push_back(Frame{index, macros_[index].bodyBegin, ++origins_, lineStart});
+        frames_.push_back(Frame{index, macros_[index].bodyBegin, lineStart});
     }
 
     const Source& src_;
@@ -681,7 +679,6 @@ private:
     std::vector<uint32_t> macroAt_;  // raw index -> macro, or kNotMacro
     std::vector<uint8_t> active_;
     std::vector<Frame> frames_;
-    uint32_t origins_ = 0;
     bool stop_ = false;
 };
 
@@ -709,7 +706,7 @@ bool canEnd(const Token& t, bool directive) {
 }
 
 void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
-    out.reserve(in.size() + in.size() / 8 + 1);
+    out.reserve(in.size() + in.size() / 2 + 1);
     std::vector<uint8_t> brackets;  // '(' or '{', innermost last
     bool directive = false, statementStart = true;
     Token prev;  // the last token pushed (kind End: none yet)
@@ -719,7 +716,6 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
         nl.kind = Tok::Newline;
         nl.flags = flags;
         nl.offset = prev.offset + prev.length;
-        nl.origin = prev.origin;
         out.push_back(nl);
     };
     for (size_t i = 0; i < in.size(); ++i) {
@@ -774,8 +770,10 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
 }  // namespace
 
 TokenStream lex(const Source& src, Diagnostics& diags) {
+    // Fresh memory is the main cost of lexing a large file, so every stage reserves what
+    // it may need once (untouched reserved pages cost nothing) and is freed when done.
     std::vector<Token> raw;
-    raw.reserve(src.text().size() / 4 + 16);
+    raw.reserve(src.text().size() / 2 + 16);
     Scanner scanner(src, diags, raw);
     scanner.run();
     Token end;
@@ -784,14 +782,18 @@ TokenStream lex(const Source& src, Diagnostics& diags) {
     end.offset = static_cast<uint32_t>(src.text().size());
     raw.push_back(end);
 
-    std::vector<Token> expanded;
-    Expander expander(src, diags, raw, expanded);
-    expander.run();
-    raw.clear();
-    raw.shrink_to_fit();
-
     TokenStream ts;
-    ts.complete = !scanner.stopped() && !expander.stopped();
+    ts.complete = !scanner.stopped();
+    const bool macros = std::any_of(raw.begin(), raw.end(), [](const Token& t) { return t.kind == Tok::Hash; });
+    std::vector<Token> expanded;
+    if (macros) {
+        Expander expander(src, diags, raw, expanded);
+        expander.run();
+        ts.complete = ts.complete && !expander.stopped();
+        std::vector<Token>().swap(raw);
+    } else {
+        expanded.swap(raw);
+    }
     applyNewlineRule(expanded, ts.tokens);
     return ts;
 }

@@ -8,7 +8,7 @@
 //     separates items inside `{ }`), so the parser never looks at line breaks itself.
 //
 // Tokens do not own text: they point into the source (a macro's expansion points into
-// its #define body), so a token is 16 bytes whatever it spells.
+// its #define body), so a token is 12 bytes whatever it spells.
 #pragma once
 
 #include <cstdint>
@@ -88,7 +88,6 @@ struct Token {
     uint8_t pad = 0;
     uint32_t offset = 0;  // into the source text
     uint32_t length = 0;
-    uint32_t origin = 0;  // 0: the file itself; k > 0: the k-th macro expansion
 
     bool is(Tok t) const { return kind == t; }
     bool isKw(Kw k) const { return kind == Tok::Keyword && kw == k; }

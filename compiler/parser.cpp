@@ -76,6 +76,15 @@ public:
 
     // file -> { statement (NEWLINE | ';' | EOF) }
     Ast file() {
+        // Upper bounds from the token count, so that no array is copied while it grows
+        // (untouched reserved memory costs nothing).
+        const size_t n = t_.size();
+        ast_.exprs.reserve(n / 2 + 16);
+        ast_.csg.reserve(n / 2 + 16);
+        ast_.lists.reserve(n / 2 + 16);
+        ast_.chainItems.reserve(n / 2 + 16);
+        ast_.assigns.reserve(n / 3 + 16);
+        ast_.stmts.reserve(n / 2 + 16);
         while (!at(Tok::End)) {
             if (at(Tok::Newline) || at(Tok::Semicolon)) {
                 ++p_;
