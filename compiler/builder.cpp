@@ -180,20 +180,20 @@ private:
             const DirectiveItem& item = ast_.items[s.first + i];
             if (!set(text(item.nameTok), item))
                 error(item.nameTok, fmt::format("unknown {} setting '{}' ({} takes {})", what,
-                                                text(item.nameTok), what, known));
+                                                clip(text(item.nameTok)), what, known));
         }
     }
 
     std::optional<Vec3> wantVector(const DirectiveItem& item) {
         if (!item.vector) {
-            error(item.nameTok, fmt::format("'{}' takes a vector '<x, y, z>'", text(item.nameTok)));
+            error(item.nameTok, fmt::format("'{}' takes a vector '<x, y, z>'", clip(text(item.nameTok))));
             return std::nullopt;
         }
         return vectorValue(item);
     }
     std::optional<double> wantScalar(const DirectiveItem& item) {
         if (item.vector) {
-            error(item.nameTok, fmt::format("'{}' takes a number, not a vector", text(item.nameTok)));
+            error(item.nameTok, fmt::format("'{}' takes a number, not a vector", clip(text(item.nameTok))));
             return std::nullopt;
         }
         return constant(item.e[0]);
@@ -317,7 +317,7 @@ private:
         }
         auto [it, inserted] = materialByName_.emplace(name, static_cast<uint32_t>(g_.materials.size()));
         if (!inserted) {
-            error(s.nameTok, fmt::format("material '{}' is already defined at line {}", name,
+            error(s.nameTok, fmt::format("material '{}' is already defined at line {}", clip(name),
                                          line(materialTok_[it->second])));
             return;
         }
@@ -384,13 +384,13 @@ private:
                 case StmtKind::Module: {
                     ModuleInfo& m = modules_[moduleFor(s.nameTok)];
                     if (m.decl != kNoNode) {
-                        error(s.nameTok, fmt::format("module {} is already declared at line {}", m.name,
+                        error(s.nameTok, fmt::format("module {} is already declared at line {}", clip(m.name),
                                                      line(ast_.stmts[m.decl].nameTok)));
                     } else if (m.notationB) {
                         error(s.nameTok, fmt::format("module {} has notation-B rules (line {}), which "
                                                      "select by their conditions: it cannot also have a "
                                                      "selection function",
-                                                     m.name, line(ast_.stmts[m.rules[0]].nameTok)));
+                                                     clip(m.name), line(ast_.stmts[m.rules[0]].nameTok)));
                     } else {
                         m.decl = si;
                     }
@@ -401,7 +401,7 @@ private:
                     if (m.notationB) {
                         error(s.tok, fmt::format("module {} uses notation B (rule at line {}); one module "
                                                  "uses one notation",
-                                                 m.name, line(ast_.stmts[m.rules[0]].tok)));
+                                                 clip(m.name), line(ast_.stmts[m.rules[0]].tok)));
                         break;
                     }
                     m.hasRules = true;
@@ -414,7 +414,7 @@ private:
                         const uint32_t where = m.decl != kNoNode ? ast_.stmts[m.decl].tok : ast_.stmts[m.rules[0]].tok;
                         error(s.tok, fmt::format("module {} uses notation A (line {}); one module uses "
                                                  "one notation",
-                                                 m.name, line(where)));
+                                                 clip(m.name), line(where)));
                         break;
                     }
                     formals(m, si);
@@ -427,7 +427,7 @@ private:
                     const std::string_view name = text(s.nameTok);
                     auto [it, inserted] = definitionByName_.emplace(name, si);
                     if (!inserted)
-                        error(s.nameTok, fmt::format("'{}' is already defined at line {}", name,
+                        error(s.nameTok, fmt::format("'{}' is already defined at line {}", clip(name),
                                                      line(ast_.stmts[it->second].nameTok)));
                     break;
                 }
@@ -438,18 +438,18 @@ private:
             if (definitionByName_.count(m.name)) {
                 const Stmt& d = ast_.stmts[definitionByName_.at(m.name)];
                 error(d.nameTok, fmt::format("'{}' is a module (line {}) and cannot also be a definition",
-                                             m.name, line(m.firstTok)));
+                                             clip(m.name), line(m.firstTok)));
             }
             if (m.notationB || dropped(m.name)) continue;
             if (m.decl == kNoNode) {
                 error(ast_.stmts[m.rules[0]].nameTok,
                       fmt::format("module {} is not declared: add a line '{} <selection function>' "
                                   "that chooses among its rules",
-                                  m.name, m.name));
+                                  clip(m.name), clip(m.name)));
                 continue;
             }
             if (m.rules.empty()) {
-                error(ast_.stmts[m.decl].nameTok, fmt::format("module {} has no rules", m.name));
+                error(ast_.stmts[m.decl].nameTok, fmt::format("module {} has no rules", clip(m.name)));
                 continue;
             }
             // Rules 1..n, each exactly once; the S-node's children in rule order.
@@ -462,7 +462,7 @@ private:
                 const Stmt& b = ast_.stmts[m.rules[i]];
                 if (a.number == b.number) {
                     error(b.labelTok, fmt::format("rule {} of module {} is already given at line {}",
-                                                  b.number, m.name, line(a.labelTok)));
+                                                  b.number, clip(m.name), line(a.labelTok)));
                     ok = false;
                 }
             }
@@ -472,7 +472,7 @@ private:
                 if (r.number != i + 1) {
                     error(r.labelTok, fmt::format("module {} has no rule {}: its rules must be numbered "
                                                   "1 to {} without gaps",
-                                                  m.name, i + 1, m.rules.size()));
+                                                  clip(m.name), i + 1, m.rules.size()));
                     break;
                 }
             }
@@ -486,7 +486,7 @@ private:
         for (size_t i = 0; i < mine.size(); ++i)
             for (size_t j = 0; j < i; ++j)
                 if (text(mine[i]) == text(mine[j]))
-                    error(mine[i], fmt::format("parameter '{}' is listed twice", text(mine[i])));
+                    error(mine[i], fmt::format("parameter '{}' is listed twice", clip(text(mine[i]))));
         if (m.formalsRule == kNoNode) {
             m.formals = mine;
             m.formalsRule = si;
@@ -497,7 +497,7 @@ private:
         if (!same)
             error(s.nameTok, fmt::format("rule '{}' gives module {} the parameters ({}), but its rule at "
                                          "line {} gives ({})",
-                                         text(s.labelTok), m.name, formalList(mine), line(ast_.stmts[m.formalsRule].tok),
+                                         clip(text(s.labelTok)), clip(m.name), formalList(mine), line(ast_.stmts[m.formalsRule].tok),
                                          formalList(m.formals)));
     }
 
@@ -505,7 +505,7 @@ private:
         std::string s;
         for (size_t i = 0; i < toks.size(); ++i) {
             if (i) s += ", ";
-            s += text(toks[i]);
+            s += clip(text(toks[i]));
         }
         return s;
     }
@@ -588,13 +588,13 @@ private:
                     std::string path;
                     size_t k = 0;
                     while (stack[k].stmt != d) ++k;
-                    for (size_t j = k; j < stack.size(); ++j) path += fmt::format("{} -> ", text(ast_.stmts[stack[j].stmt].nameTok));
+                    for (size_t j = k; j < stack.size(); ++j) path += fmt::format("{} -> ", clip(text(ast_.stmts[stack[j].stmt].nameTok)));
                     path += text(ast_.stmts[d].nameTok);
                     if (!cyclic_.count(d)) {
                         error(ast_.stmts[d].nameTok,
                               fmt::format("definition '{}' refers to itself ({}): only a module can be "
                                           "recursive",
-                                          text(ast_.stmts[d].nameTok), path));
+                                          clip(text(ast_.stmts[d].nameTok)), path));
                     }
                     for (size_t j = k; j < stack.size(); ++j) cyclic_.insert(stack[j].stmt);
                     continue;
@@ -716,7 +716,7 @@ private:
                     auto it = materialByName_.find(name);
                     if (it == materialByName_.end()) {
                         if (!dropped(name))
-                            error(n.nameTok, fmt::format("unknown material '{}'{}", name,
+                            error(n.nameTok, fmt::format("unknown material '{}'{}", clip(name),
                                                      materialByName_.empty() ? " (no material is defined)" : ""));
                         return child;
                     }
@@ -742,9 +742,9 @@ private:
         }
         if (dropped(name)) return placeholder();
         if (assigned_.count(name))
-            error(n.nameTok, fmt::format("'{}' is a parameter, not a module or definition", name));
+            error(n.nameTok, fmt::format("'{}' is a parameter, not a module or definition", clip(name)));
         else
-            error(n.nameTok, fmt::format("unknown module or definition '{}'", name));
+            error(n.nameTok, fmt::format("unknown module or definition '{}'", clip(name)));
         return placeholder();
     }
 
@@ -754,20 +754,20 @@ private:
         if (it == moduleByName_.end()) {
             if (dropped(name)) return placeholder();
             if (definitionByName_.count(name))
-                error(n.nameTok, fmt::format("definition '{}' takes no arguments", name));
+                error(n.nameTok, fmt::format("definition '{}' takes no arguments", clip(name)));
             else
-                error(n.nameTok, fmt::format("unknown module '{}'", name));
+                error(n.nameTok, fmt::format("unknown module '{}'", clip(name)));
             return placeholder();
         }
         const ModuleInfo& m = modules_[it->second];
         if (!m.notationB) {
             error(n.nameTok, fmt::format("module {} uses notation A and has no parameter list; set its "
                                          "parameters with a C-node, as in '{{c = ...}} {}'",
-                                         name, name));
+                                         clip(name), clip(name)));
             return placeholder();
         }
         if (n.count != m.formals.size()) {
-            error(n.nameTok, fmt::format("module {} takes {} ({}), found {}", name,
+            error(n.nameTok, fmt::format("module {} takes {} ({}), found {}", clip(name),
                                          argumentCount(static_cast<uint32_t>(m.formals.size())),
                                          formalList(m.formals), n.count));
             return placeholder();
@@ -809,7 +809,7 @@ private:
         const TransformInfo info = transformInfo(n.op);
         const NodeId child = csg(n.child);
         if (n.count != info.args) {
-            error(n.tok, fmt::format("{} takes {} ({}), found {}", text(n.tok), argumentCount(info.args), info.names, n.count));
+            error(n.tok, fmt::format("{} takes {} ({}), found {}", clip(text(n.tok)), argumentCount(info.args), info.names, n.count));
             return child;
         }
         Transform tr;
@@ -835,9 +835,9 @@ private:
         const uint32_t want = primitiveArgCount(n.prim);
         if (n.count != want) {
             if (want == 0)
-                error(n.tok, fmt::format("{} takes no arguments", text(n.tok)));
+                error(n.tok, fmt::format("{} takes no arguments", clip(text(n.tok))));
             else
-                error(n.tok, fmt::format("{} takes {} ({}), found {}", text(n.tok), argumentCount(want),
+                error(n.tok, fmt::format("{} takes {} ({}), found {}", clip(text(n.tok)), argumentCount(want),
                                          want == 2 ? "R, r" : "x1, y1, z1, x2, y2, z2, x3, y3, z3", n.count));
             return placeholder();
         }
@@ -905,10 +905,10 @@ private:
             case ExKind::Name: {
                 const std::string_view name = text(n.tok);
                 if (constantOnly_) {
-                    error(n.tok, fmt::format("'{}': the values of a directive are constants, not parameters", name));
+                    error(n.tok, fmt::format("'{}': the values of a directive are constants, not parameters", clip(name)));
                 } else if (!assigned_.count(name) && ast_.dropped == 0 &&
                            reportedUnknown_.insert(name).second) {
-                    error(n.tok, fmt::format("unknown parameter '{}': no C-node or formal parameter assigns it", name));
+                    error(n.tok, fmt::format("unknown parameter '{}': no C-node or formal parameter assigns it", clip(name)));
                 }
                 emit(Op::Load, slotOf(name));
                 cg.readsSlot = true;
@@ -997,12 +997,12 @@ private:
         const std::string_view name = text(n.tok);
         const uint32_t* args = ast_.lists.data() + n.first;
         auto wrongCount = [&](const std::string& want) {
-            error(n.tok, fmt::format("{}() takes {}, found {}", name, want, n.count));
+            error(n.tok, fmt::format("{}() takes {}, found {}", clip(name), want, n.count));
             emit(Op::Const, 0, 0.0);
             cg.push();
         };
         if (f.kind != Tok::Keyword) {
-            error(n.tok, fmt::format("unknown function '{}'", name));
+            error(n.tok, fmt::format("unknown function '{}'", clip(name)));
             emit(Op::Const, 0, 0.0);
             cg.push();
             return;
@@ -1047,7 +1047,7 @@ private:
         }
         const FuncInfo* info = functionInfo(f.kw);
         if (!info) {
-            error(n.tok, fmt::format("'{}' is not a function", name));
+            error(n.tok, fmt::format("'{}' is not a function", clip(name)));
             emit(Op::Const, 0, 0.0);
             cg.push();
             return;

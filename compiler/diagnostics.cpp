@@ -15,6 +15,14 @@ uint32_t Diagnostics::addFile(std::string name, std::string_view text) {
 }
 
 void Diagnostics::error(FileLoc loc, std::string message) {
+    // A message quotes names from the input, which may be megabytes long.
+    constexpr size_t kMaxMessage = 400;
+    if (message.size() > kMaxMessage) {
+        size_t cut = kMaxMessage;
+        while (cut > 0 && (static_cast<unsigned char>(message[cut]) & 0xC0) == 0x80) --cut;
+        message.resize(cut);
+        message += "...";
+    }
     if (errors_.size() + 1 < kMaxErrors) {
         errors_.push_back(Diagnostic{loc, std::move(message)});
     } else if (errors_.size() + 1 == kMaxErrors) {

@@ -64,5 +64,14 @@ TEST(DiagnosticsFormat, CollectionStopsAtTheLimitAndSaysSo) {
     EXPECT_NE(d.errors().back().message.find("too many errors"), std::string::npos);
 }
 
+TEST(DiagnosticsFormat, HugeMessagesAreCut) {
+    Diagnostics d;
+    d.addFile("a.pcsg", "x");
+    d.error({0, 1, 1}, "unknown module '" + std::string(1 << 20, 'x') + "'");
+    ASSERT_EQ(d.errors().size(), 1u);
+    EXPECT_LE(d.errors()[0].message.size(), 410u);
+    EXPECT_EQ(d.errors()[0].message.substr(d.errors()[0].message.size() - 3), "...");
+}
+
 }  // namespace
 }  // namespace pcsg

@@ -124,6 +124,13 @@ std::string_view keywordName(Kw k) {
     return "?";
 }
 
+std::string clip(std::string_view s) {
+    if (s.size() <= 64) return std::string(s);
+    size_t cut = 60;
+    while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+    return std::string(s.substr(0, cut)) + "...";
+}
+
 std::string_view spelling(const Source& src, const Token& t) {
     if (t.kind == Tok::End || t.kind == Tok::Newline) return {};
     return src.text().substr(t.offset, t.length);
@@ -528,7 +535,7 @@ private:
         if (!sameLine(i + 1) || spelling(src_, raw_[i + 1]) != "define") {
             if (sameLine(i + 1))
                 error(raw_[i + 1], fmt::format("unknown directive '#{}': only #define is supported",
-                                               spelling(src_, raw_[i + 1])));
+                                               clip(spelling(src_, raw_[i + 1]))));
             else
                 error(hash, "expected 'define' after '#'");
             return skipLine(i + 1);
@@ -540,7 +547,7 @@ private:
         const Token& nameTok = raw_[i + 2];
         const std::string_view name = spelling(src_, nameTok);
         if (nameTok.kind == Tok::Keyword) {
-            error(nameTok, fmt::format("'{}' is a keyword and cannot be a macro name", name));
+            error(nameTok, fmt::format("'{}' is a keyword and cannot be a macro name", clip(name)));
             return skipLine(i + 3);
         }
         // The body.
@@ -550,13 +557,13 @@ private:
             if (raw_[begin].kind == Tok::LBrace) {
                 const size_t close = matchBrace(begin);
                 if (close == 0) {
-                    error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", name));
+                    error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", clip(name)));
                     stop_ = true;
                     return raw_.size() - 1;
                 }
                 if (close > lineEnd && sameLine(close)) {
                     error(raw_[close], fmt::format("unexpected {} after the block of #define {}",
-                                                   describe(src_, raw_[close]), name));
+                                                   describe(src_, raw_[close]), clip(name)));
                     end = close;
                     next = skipLine(close);
                 } else {
@@ -569,7 +576,7 @@ private:
             // The paper's figure 8: the name alone, the block on the following lines.
             const size_t close = matchBrace(begin);
             if (close == 0) {
-                error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", name));
+                error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", clip(name)));
                 stop_ = true;
                 return raw_.size() - 1;
             }
@@ -577,25 +584,25 @@ private:
             next = close;
             if (sameLine(close)) {
                 error(raw_[close], fmt::format("unexpected {} after the block of #define {}",
-                                               describe(src_, raw_[close]), name));
+                                               describe(src_, raw_[close]), clip(name)));
                 next = skipLine(close);
             }
         }
         const uint32_t index = byName_.at(name);
         Macro& m = macros_[index];
         if (m.hash != i) {
-            error(nameTok, fmt::format("macro '{}' is already defined at line {}", name,
+            error(nameTok, fmt::format("macro '{}' is already defined at line {}", clip(name),
                                        src_.loc(raw_[m.hash].offset).line));
             return next;
         }
         for (size_t k = begin; k < end; ++k) {
             if (raw_[k].kind == Tok::Hash) {
-                error(raw_[k], fmt::format("'#' inside the body of #define {}", name));
+                error(raw_[k], fmt::format("'#' inside the body of #define {}", clip(name)));
                 end = k;
                 break;
             }
             if (raw_[k].kind == Tok::Ident && spelling(src_, raw_[k]) == name && !m.reported) {
-                error(raw_[k], fmt::format("macro '{}' expands into itself", name));
+                error(raw_[k], fmt::format("macro '{}' expands into itself", clip(name)));
                 m.reported = true;
             }
         }
@@ -651,13 +658,13 @@ private:
     bool usable(uint32_t index, const Token& at) {
         Macro& m = macros_[index];
         if (!m.defined) {
-            error(at, fmt::format("macro '{}' is used before its #define at line {}", m.name,
+            error(at, fmt::format("macro '{}' is used before its #define at line {}", clip(m.name),
                                   src_.loc(raw_[m.hash].offset).line));
             return false;
         }
         if (active_[index]) {
             if (!m.reported)
-                error(at, fmt::format("macro '{}' expands into itself", m.name));
+                error(at, fmt::format("macro '{}' expands into itself", clip(m.name)));
             m.reported = true;
             return false;
         }

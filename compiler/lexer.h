@@ -107,6 +107,8 @@ TokenStream lex(const Source& src, Diagnostics& diags);
 // The spelling of a token ("end of line" for a Newline): for messages.
 std::string describe(const Source& src, const Token& t);
 std::string_view spelling(const Source& src, const Token& t);
+// A name from the input as a message quotes it: at most 64 bytes.
+std::string clip(std::string_view name);
 // The keyword spelled by an identifier, or Kw::None.
 Kw keywordOf(std::string_view word);
 std::string_view keywordName(Kw k);

@@ -216,9 +216,9 @@ private:
         double value = 0;
         std::from_chars(digits.data(), digits.data() + digits.size(), value);
         if (!(n.flags & kInteger) || value < 1)
-            fail(p_, fmt::format("a rule number must be a whole number from 1 up, found '{}'", digits));
+            fail(p_, fmt::format("a rule number must be a whole number from 1 up, found '{}'", clip(digits)));
         if (value > kMaxRuleNumber)
-            fail(p_, fmt::format("rule number {} is too large (at most {})", digits, kMaxRuleNumber));
+            fail(p_, fmt::format("rule number {} is too large (at most {})", clip(digits), kMaxRuleNumber));
         s.number = static_cast<uint32_t>(value);
         p_ += 2;
         s.nameTok = name("a module");
