@@ -144,10 +144,11 @@ TEST(GraphCommand, MissingGraphvizGetsAnInstallHint) {
 
 TEST(GraphCommand, BadSceneAndBadOutputNames) {
     TempDir dir;
-    const ChildResult bad = pcsg({"graph", dir.write("bad.pcsg", "S if(\n")});
+    const ChildResult bad = pcsg({"graph", dir.write("bad.pcsg", "sphere ∪ ∪ cube\n")});
     EXPECT_EQ(bad.exitCode, 1);
     EXPECT_EQ(bad.out, "");
     EXPECT_NE(bad.err.find("bad.pcsg:1:"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find(": error: "), std::string::npos) << bad.err;
 
     const std::string scene = dir.write("s.pcsg", testing::kSierpinskiA);
     const ChildResult ext = pcsg({"graph", scene, "-o", dir.file("s.txt")});
