@@ -372,6 +372,8 @@ struct Item {
 
 class TreeWriter {
 public:
+    static constexpr size_t kMaxNesting = 256;  // deeper unions are flattened and regrouped
+
     TreeWriter(Out& o, const ExpandedTree& t, const PovOptions& opt, PovWriteStats& stats)
         : o_(o), t_(t), opt_(opt), stats_(stats), boxes_(nodeBoxes(t)),
           maxChildren_(std::max<uint32_t>(opt.maxUnionChildren, 2)) {}
@@ -402,11 +404,18 @@ private:
                 stack_.pop_back();
                 return;
             }
-            if (node.kind == TreeKind::Union && node.count > maxChildren_) {
-                // Regroup: the operands become a group item over a run of `members`.
+            const bool deep = stack_.size() > kMaxNesting;
+            if (node.kind == TreeKind::Union && it.next == 0 && (node.count > maxChildren_ || deep)) {
+                // Regroup: the operands become a group item over a run of `members`. Deep
+                // in the tree (a long chain of unions from a linear recursion), the
+                // union's whole union-subtree is flattened first: POV-Ray's parser
+                // crashes at about 19,000 nested braces.
                 const uint32_t n = it.node;
                 const size_t lo = members_.size();
-                members_.insert(members_.end(), t_.childrenOf(n), t_.childrenOf(n) + node.count);
+                if (deep)
+                    flattenUnion(n);
+                else
+                    members_.insert(members_.end(), t_.childrenOf(n), t_.childrenOf(n) + node.count);
                 stack_.pop_back();
                 Item g;
                 g.group = true;
@@ -468,6 +477,22 @@ private:
         if (opt_.boundUnions && boundable(it.box)) putBound(o_, it.box);
         o_.put(" }}\n");
         finishGroup();
+    }
+
+    // Appends the operands of union n, looking through nested unions, to `members_`.
+    void flattenUnion(uint32_t n) {
+        std::vector<uint32_t> todo = {n};
+        while (!todo.empty()) {
+            const uint32_t u = todo.back();
+            todo.pop_back();
+            const uint32_t* c = t_.childrenOf(u);
+            for (uint32_t i = 0; i < t_.nodes[u].count; ++i) {
+                if (t_.nodes[c[i]].kind == TreeKind::Union)
+                    todo.push_back(c[i]);
+                else
+                    members_.push_back(c[i]);
+            }
+        }
     }
 
     void finishGroup() {

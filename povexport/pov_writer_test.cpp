@@ -231,6 +231,29 @@ TEST(PovWriter, BigUnionsAreRegroupedIntoABalancedNest) {
     EXPECT_LT(widths, 3000.0 * 4);
 }
 
+TEST(PovWriter, LongUnionChainsAreFlattenedBeforePovRaysBraceLimit) {
+    // ((((cube ∪ sphere) ∪ sphere) ∪ sphere) ...) 30,000 deep: POV-Ray's parser crashes
+    // at about 19,000 nested braces.
+    Graph g;
+    defaultScene(g);
+    NodeId n = primitive(g, P::Cube);
+    for (int i = 0; i < 30000; ++i)
+        n = g.addNode(NodeKind::Union, kNone,
+                      {n, transform(g, TransformOp::Move, {0.001 * i, 0, 0}, primitive(g, P::Sphere))});
+    g.axiom = n;
+    const std::string s = exportText(g);
+    int depth = 0, maxDepth = 0;
+    for (char c : s) {
+        depth += c == '{';
+        depth -= c == '}';
+        maxDepth = std::max(maxDepth, depth);
+    }
+    EXPECT_EQ(depth, 0);
+    EXPECT_LT(maxDepth, 300);
+    EXPECT_EQ(occurrences(s, "sphere{"), 30000u);
+    EXPECT_EQ(occurrences(s, "box{"), 1u);
+}
+
 TEST(PovWriter, StreamsWithoutHoldingTheText) {
     // Sierpinski order 9 with spheres: 262,144 primitives into a stream that only counts.
     struct CountingBuf : std::streambuf {
