@@ -146,7 +146,7 @@ public:
 
     template <class... Args>
     void put(fmt::format_string<Args...> f, Args&&... args) {
-        fmt::format_to(std::back_inserter(buf_), f, std::forward<Args>(args)...);
+        fmt::format_to(fmt::appender(buf_), f, std::forward<Args>(args)...);
         if (buf_.size() > (1 << 16)) flush();
     }
     void raw(std::string_view s) {
@@ -155,7 +155,7 @@ public:
     }
     void num(double v) {
         if (v == 0) v = 0;  // no "-0"
-        fmt::format_to(std::back_inserter(buf_), "{}", v);
+        fmt::format_to(fmt::appender(buf_), "{}", v);
     }
     void vec(const Vec3& v) {
         buf_.push_back('<');
