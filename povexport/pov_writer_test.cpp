@@ -450,7 +450,7 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
         EXPECT_EQ(r.problems(), "") << k.name;
         ASSERT_EQ(r.width, W) << k.name;
         ASSERT_EQ(r.height, H) << k.name;
-        int mismatches = 0, covered = 0;
+        int onlyPov = 0, onlyExpected = 0, covered = 0;
         std::string picture;
         for (int j = 0; j < H; ++j) {
             for (int i = 0; i < W; ++i) {
@@ -469,14 +469,17 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
                 }
                 const bool got = r.at(i, j, 0) > 128;
                 covered += expected;
-                if (got != expected) ++mismatches;
+                onlyPov += got && !expected;
+                onlyExpected += expected && !got;
                 picture += got == expected ? (got ? '#' : '.') : (got ? 'P' : 'e');
             }
             picture += '\n';
         }
         EXPECT_GT(covered, W * H / 30) << k.name << ": the object is too small to test anything";
-        if (mismatches > 2) std::cerr << k.name << ": " << mismatches << " mismatches\n";
-        EXPECT_LE(mismatches, 6) << k.name << " (P: only POV-Ray covers, e: only expected)\n" << picture;
+        // Marching can step over a thin chord near a corner (a pixel only POV-Ray covers);
+        // it cannot invent coverage, so pixels only expected are held tighter.
+        EXPECT_LE(onlyPov, 10) << k.name << " (P: only POV-Ray covers, e: only expected)\n" << picture;
+        EXPECT_LE(onlyExpected, 3) << k.name << " (P: only POV-Ray covers, e: only expected)\n" << picture;
     }
 }
 
