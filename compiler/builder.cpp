@@ -389,8 +389,10 @@ private:
                     } else if (m.notationB) {
                         error(s.nameTok, fmt::format("module {} has notation-B rules (line {}), which "
                                                      "select by their conditions: it cannot also have a "
-                                                     "selection function",
-                                                     clip(m.name), line(ast_.stmts[m.rules[0]].nameTok)));
+                                                     "selection function (to start from {}, write the "
+                                                     "axiom with a label: 'w: {}(...)')",
+                                                     clip(m.name), line(ast_.stmts[m.rules[0]].nameTok),
+                                                     clip(m.name), clip(m.name)));
                     } else {
                         m.decl = si;
                     }

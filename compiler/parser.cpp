@@ -294,6 +294,11 @@ private:
             fail(p_, "a rule needs a number (notation A: '1: S -> ...') or a label (notation B: "
                      "'p1: S -> ...')");
         s.expr = expr();
+        if (isCsgOperator(tok().kind))
+            fail(p_, fmt::format("expected the end of the statement, found {}: this line declares "
+                                 "module {} (a name followed by its selection function); an axiom "
+                                 "that calls a notation-B module needs a label, as in 'w: {}(...)'",
+                                 describe(src_, tok()), clip(text(s.nameTok)), clip(text(s.nameTok))));
         ast_.stmts.push_back(s);
     }
 
