@@ -544,8 +544,11 @@ ExpansionCount countExpansion(const Graph& g, const CountOptions& options) {
 ExpandedTree expand(const Graph& g, const ExpandOptions& options) {
     // Node ids are 32-bit.
     const uint64_t maxNodes = std::min<uint64_t>(options.maxNodes, UINT32_MAX - 1);
-    const uint64_t visits =
-        options.countVisits ? options.countVisits : addSat(mulSat(maxNodes, 16), 1'000'000);
+    // The counting pass may work somewhat longer than the expansion would (so that an
+    // expansion over budget can say exactly how large it would be): a few seconds at most.
+    const uint64_t visits = options.countVisits
+                                ? options.countVisits
+                                : std::max<uint64_t>(addSat(mulSat(maxNodes, 16), 1'000'000), 100'000'000);
 
     // First count (cheap where memoisable): an expansion over budget fails before it
     // allocates anything, with the exact figure, and one within budget gets its arrays

@@ -90,8 +90,9 @@ public:
 
 struct ExpandOptions {
     uint64_t maxNodes = 10'000'000;  // --max-nodes
-    // Work limit of the counting pass that runs first (it sizes the arrays exactly and
-    // reports the exact need of an expansion over budget). 0: a default from maxNodes.
+    // Work limit (graph-node visits) of the counting pass that runs first: it sizes the
+    // arrays exactly and reports the exact need of an expansion over budget. 0: the
+    // larger of 16 * maxNodes + 10^6 and 10^8.
     uint64_t countVisits = 0;
 };
 

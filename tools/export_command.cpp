@@ -8,7 +8,9 @@
 //
 // Exit status: 0 success, 1 the scene is at fault (compile error, run-time error, too
 // large for the node budget), 2 something could not run (the output is not writable).
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -99,7 +101,8 @@ int runExport(const ExportOptions& o) {
             out.rdbuf()->pubsetbuf(buffer.data(), static_cast<std::streamsize>(buffer.size()));
             out.open(temp, std::ios::binary | std::ios::trunc);
             if (!out) {
-                std::cerr << "pcsg export-pov: cannot write " << temp.string() << "\n";
+                std::cerr << "pcsg export-pov: cannot write " << o.output << ": "
+                          << std::strerror(errno) << "\n";
                 return 2;
             }
             try {
@@ -146,7 +149,8 @@ int runExport(const ExportOptions& o) {
         j["write_seconds"] = writeSeconds;
         report << j.dump(2) << "\n";
     } else {
-        report << fmt::format("{}: wrote {} ({} objects, {}) in {:.3f} s\n", o.scene, o.output,
+        report << fmt::format("{}: wrote {} ({} objects, {}) in {:.3f} s\n", o.scene,
+                              o.output == "-" ? std::string("standard output") : o.output,
                               written.objects, humanBytes(written.bytes), *s.seconds);
         if (written.skipped)
             report << fmt::format("  left out {} degenerate triangle{} (no area; POV-Ray rejects them)\n",
