@@ -1,0 +1,65 @@
+// Rendering an image: pixels in tiles, in parallel with oneTBB, anti-aliasing, and the
+// image file through OpenImageIO.
+//
+//  - Every pixel's colour depends only on the pixel (fixed sample positions, no shared
+//    mutable state), so the image is the same byte for byte whatever the thread count.
+//  - --aa N: N x N stratified samples at the centres of an N x N grid of sub-pixels,
+//    averaged with equal weights.
+//  - --adaptive T: POV-Ray's +A T (sampling method 1): one sample at each pixel centre;
+//    a pixel whose colour differs from a 4-neighbour's by at least T (the sum of the
+//    absolute differences of red, green and blue after the gamma 2.5 encoding POV-Ray's
+//    Antialias_Gamma uses) gets POV-Ray's extra grid of depth x depth samples (depth 3,
+//    no jitter), and its colour is (centre + grid samples) / (depth^2 + 1). The decision
+//    is made after all centres are known, so it does not depend on the tiling.
+//  - Threads: the walk recurses once per node visit, so the render runs on threads whose
+//    stacks are sized from the scene (TraceScene::stackBytesNeeded): a thread of its own
+//    with that stack calls the parallel loop, and oneTBB's workers get the same size
+//    through tbb::global_control::thread_stack_size.
+//  - A run-time error of the scene (RuntimeError) stops the render: the first error wins
+//    (later ones from other threads are dropped), the remaining tiles are skipped, and
+//    render() rethrows it. Nothing is written.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "graph.h"
+
+namespace pcsg::tracer {
+
+struct RenderOptions {
+    int width = 640, height = 480;
+    int aa = 1;             // N x N stratified samples per pixel (1: the centre only)
+    double adaptive = 0;    // > 0: adaptive supersampling threshold (POV-Ray's +A)
+    int adaptiveDepth = 3;  // POV-Ray's +R
+    int threads = 0;        // 0: all cores
+    bool useBounds = true;  // tests compare against rendering without culling
+    // Called from worker threads with the fraction done (0..1); may be empty.
+    std::function<void(double)> progress;
+};
+
+struct RenderResult {
+    int width = 0, height = 0;
+    std::vector<float> rgb;  // linear RGB, row-major from the top-left
+    uint64_t rays = 0;
+    uint64_t nodeVisits = 0;
+    double seconds = 0;          // the render proper
+    double boundsSeconds = 0;    // computing the hyper-bounding boxes
+    uint32_t infiniteBoxes = 0;  // nodes left with unbounded boxes
+};
+
+// Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)
+// or std::runtime_error (the stack cannot be made large enough).
+RenderResult render(const Graph& g, const RenderOptions& options);
+
+// Writes an image by the file name's extension: .png (8-bit sRGB), .tif/.tiff (16-bit
+// sRGB), .exr (linear 32-bit float). Writes to a temporary file beside the target and
+// renames it, so a failed write never leaves a partial image. Throws std::runtime_error.
+void writeImage(const std::string& path, int width, int height, const std::vector<float>& rgb);
+
+// The sRGB encoding of a linear value, clamped to [0, 1].
+double srgbEncode(double linear);
+
+}  // namespace pcsg::tracer

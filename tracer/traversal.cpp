@@ -1,0 +1,458 @@
+// The walk of rays through the cyclic graph: see traversal.h.
+#include "traversal.h"
+
+#include <fmt/format.h>
+#include <pthread.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <deque>
+
+#include "span_list.h"
+
+namespace pcsg::tracer {
+
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr size_t kBytesPerVisit = 4096;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr size_t kBytesPerVisit = 4096;
+#else
+constexpr size_t kBytesPerVisit = 512;
+#endif
+#else
+constexpr size_t kBytesPerVisit = 512;
+#endif
+
+// Room left below the guard for a primitive's intersection, the evaluation code and an
+// exception's unwinding.
+constexpr uintptr_t kStackMargin = 256 * 1024;
+
+uintptr_t threadStackLimit() {
+    static thread_local uintptr_t limit = [] {
+        pthread_attr_t attr;
+        if (pthread_getattr_np(pthread_self(), &attr) != 0) return uintptr_t(0);
+        void* addr = nullptr;
+        size_t size = 0;
+        const bool ok = pthread_attr_getstack(&attr, &addr, &size) == 0;
+        pthread_attr_destroy(&attr);
+        return ok ? reinterpret_cast<uintptr_t>(addr) + kStackMargin : uintptr_t(0);
+    }();
+    return limit;
+}
+
+// Clips [t0, t1] to the part of the line inside the box; false when nothing is left.
+inline bool clipToBox(const Box& b, const Vec3& o, const Vec3& d, double& t0, double& t1) {
+    if (b.lo.x > b.hi.x) return false;  // empty
+    for (int i = 0; i < 3; ++i) {
+        if (d[i] == 0) {
+            if (o[i] < b.lo[i] || o[i] > b.hi[i]) return false;
+            continue;
+        }
+        const double inv = 1.0 / d[i];
+        double a = (b.lo[i] - o[i]) * inv, c = (b.hi[i] - o[i]) * inv;
+        if (a > c) std::swap(a, c);
+        if (a > t0) t0 = a;
+        if (c < t1) t1 = c;
+        if (!(t0 <= t1)) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// TraceScene
+
+TraceScene::TraceScene(const Graph& g, Bounds bounds) : g_(g), bounds_(std::move(bounds)) {
+    const size_t n = g.nodes.size();
+    if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
+    inverse_.assign(n, Affine::identity());
+    target_.assign(n, kNone);
+    auto constantT = [&](NodeId m) {
+        return g.nodes[m].kind == NodeKind::Transform && g.transforms[g.nodes[m].payload].constant;
+    };
+    for (NodeId m = 0; m < n; ++m) {
+        if (!constantT(m)) continue;
+        // Fuse the chain of constant T-nodes below m: inverse of M_m M_c1 ... M_ck.
+        Affine inv = g.transforms[g.nodes[m].payload].matrix.inverse();
+        NodeId c = g.child(m);
+        for (size_t guard = 0; constantT(c) && guard < n; ++guard) {
+            inv = g.transforms[g.nodes[c].payload].matrix.inverse() * inv;
+            c = g.child(c);
+        }
+        inverse_[m] = inv;
+        target_[m] = c;
+    }
+    // Longest chain of nested visits between two S-nodes (the graph without the edges into
+    // S-nodes is acyclic), then the whole walk's bound.
+    std::vector<uint32_t> indeg(n, 0), order;
+    for (NodeId m = 0; m < n; ++m)
+        for (uint32_t i = 0; i < g.nodes[m].childCount; ++i)
+            if (g.nodes[g.child(m, i)].kind != NodeKind::Select) ++indeg[g.child(m, i)];
+    std::deque<NodeId> q;
+    for (NodeId m = 0; m < n; ++m)
+        if (indeg[m] == 0) q.push_back(m);
+    while (!q.empty()) {
+        const NodeId m = q.front();
+        q.pop_front();
+        order.push_back(m);
+        for (uint32_t i = 0; i < g.nodes[m].childCount; ++i) {
+            const NodeId c = g.child(m, i);
+            if (g.nodes[c].kind != NodeKind::Select && --indeg[c] == 0) q.push_back(c);
+        }
+    }
+    std::vector<uint64_t> longest(n, 1);
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+        const NodeId m = *it;
+        for (uint32_t i = 0; i < g.nodes[m].childCount; ++i) {
+            const NodeId c = g.child(m, i);
+            const uint64_t below = g.nodes[c].kind == NodeKind::Select ? 1 : longest[c];
+            longest[m] = std::max(longest[m], below + 1);
+        }
+    }
+    uint64_t k = 1;
+    for (uint64_t l : longest) k = std::max(k, l);
+    if (order.size() != n) k = n + 1;  // not acyclic between S-nodes: be generous
+    recursionBound_ = (static_cast<uint64_t>(g.scene.settings.maxDepth) + 2) * k;
+}
+
+size_t TraceScene::stackBytesNeeded() const {
+    const double bytes = static_cast<double>(recursionBound_) * kBytesPerVisit + 4.0 * 1024 * 1024;
+    return static_cast<size_t>(std::min(bytes, 64.0 * 1024 * 1024 * 1024));
+}
+
+// ---------------------------------------------------------------------------------------
+// Tracer
+
+Tracer::FrameStack::FrameStack(size_t frameSize)
+    : frameSize_(std::max<size_t>(frameSize, 1)),
+      perBlock_(std::max<size_t>(4096 / frameSize_, 16)) {}
+
+double* Tracer::FrameStack::push() {
+    const size_t b = used_ / perBlock_;
+    if (b == blocks_.size()) blocks_.push_back(std::make_unique<double[]>(perBlock_ * frameSize_));
+    double* f = blocks_[b].get() + (used_ % perBlock_) * frameSize_;
+    ++used_;
+    return f;
+}
+
+Tracer::Tracer(const TraceScene& scene)
+    : scene_(scene), g_(scene.g_), frames_(scene.g_.slotCount()) {
+    rootFrame_.assign(std::max<size_t>(g_.slotCount(), 1), 0.0);
+    initFrame(g_, rootFrame_.data());
+}
+
+void Tracer::checkStack() {
+    const auto here = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));
+    if (here < lowWater_) lowWater_ = here;
+    if (stackLimit_ == 0) stackLimit_ = threadStackLimit();
+    if (here < stackLimit_)
+        throw StackExhausted(fmt::format(
+            "the ray tracer's stack is too small for this scene's recursion depth (max_depth {})",
+            g_.scene.settings.maxDepth));
+}
+
+bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
+    frames_.reset();
+    spans_.clear();
+    order_.clear();
+    if (g_.axiom == kNone) return false;
+    const Ctx c{rootFrame_.data(), kRootPath, 0, 0};
+    const LRay r{origin, dir};
+    if (scene_.useBounds) {
+        double t0 = tmin, t1 = tmax;
+        if (!clipToBox(scene_.bounds_.node[g_.axiom], origin, dir, t0, t1)) return false;
+    }
+    LocalHit hit{};
+    double best = tmax;
+    if (!first(g_.axiom, r, c, tmin, best, hit)) return false;
+    out.t = hit.t;
+    out.normal = hit.normal;
+    out.material = hit.material;
+    return true;
+}
+
+bool Tracer::firstHit(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
+                      SurfaceHit& hit) {
+    anyHit_ = false;
+    return walk(origin, dir, tmin, tmax, hit);
+}
+
+bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tmax) {
+    anyHit_ = true;
+    SurfaceHit hit;
+    return walk(origin, dir, tmin, tmax, hit);
+}
+
+// The first boundary of the span list at spans_[base, base + count) with tmin < t < tmax.
+bool Tracer::boundaryHit(size_t base, size_t count, double tmin, double tmax, LocalHit& hit) {
+    for (size_t k = 0; k < count; ++k) {
+        const Span& s = spans_[base + k];
+        const Boundary* b = nullptr;
+        if (s.in.t > tmin)
+            b = &s.in;
+        else if (s.out.t > tmin)
+            b = &s.out;
+        else
+            continue;
+        if (!(b->t < tmax)) return false;
+        hit.t = b->t;
+        hit.normal = b->normal;
+        hit.material = b->material;
+        return true;
+    }
+    return false;
+}
+
+bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& tmax,
+                   LocalHit& hit) {
+    ++visits_;
+    const Node& node = g_.nodes[n];
+    switch (node.kind) {
+        case NodeKind::Select: {
+            const uint32_t depth = c.depth + 1;
+            const EvalState st{c.frame, c.path};
+            try {
+                checkDepth(g_, n, depth, st);
+                checkStack();
+                if (scene_.useBounds) {
+                    double t0 = tmin, t1 = tmax;
+                    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r.o, r.d, t0, t1))
+                        return false;
+                }
+                const uint32_t rule = selectRule(g_, n, st);
+                const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
+                return first(g_.child(n, rule), r, cc, tmin, tmax, hit);
+            } catch (RuntimeError& e) {
+                e.enterModule(g_.modules[node.payload].name);
+                throw;
+            }
+        }
+        case NodeKind::Calc: {
+            double* f = frames_.push();
+            applyCalc(g_, n, EvalState{c.frame, c.path}, f);
+            const bool found =
+                first(g_.child(n), r, Ctx{f, c.path, c.depth, c.material}, tmin, tmax, hit);
+            frames_.pop();
+            return found;
+        }
+        case NodeKind::Transform: {
+            NodeId target = scene_.target_[n];
+            Affine computed;
+            const Affine* inv = &scene_.inverse_[n];
+            if (target == kNone) {
+                computed = transformMatrix(g_, n, EvalState{c.frame, c.path}).inverse();
+                inv = &computed;
+                target = g_.child(n);
+            }
+            const LRay rr{inv->point(r.o), inv->vector(r.d)};
+            if (!first(target, rr, c, tmin, tmax, hit)) return false;
+            hit.normal = inv->transposedVector(hit.normal);
+            return true;
+        }
+        case NodeKind::Paint:
+            return first(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload}, tmin, tmax,
+                         hit);
+        case NodeKind::Union: {
+            // Front to back by box entry; stop when the next box starts beyond the best hit.
+            const size_t base = order_.size();
+            for (uint32_t i = 0; i < node.childCount; ++i) {
+                double t0 = tmin, t1 = tmax;
+                if (scene_.useBounds &&
+                    !clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, t0, t1))
+                    continue;
+                order_.emplace_back(t0, i);
+            }
+            const size_t end = order_.size();
+            if (end - base > 1) std::sort(order_.begin() + base, order_.begin() + end);
+            bool found = false;
+            for (size_t k = base; k < end; ++k) {
+                const auto [entry, i] = order_[k];
+                if (!(entry < tmax)) break;
+                const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
+                if (first(g_.child(n, i), r, cc, tmin, tmax, hit)) {
+                    found = true;
+                    if (anyHit_) break;
+                }
+            }
+            order_.resize(base);
+            return found;
+        }
+        case NodeKind::Intersection:
+        case NodeKind::Difference: {
+            const size_t base = spans_.size();
+            const size_t count = spans(n, r, c, tmin, tmax);
+            const bool found = boundaryHit(base, count, tmin, tmax, hit);
+            spans_.resize(base);
+            if (found) tmax = hit.t;
+            return found;
+        }
+        case NodeKind::Primitive: {
+            const Primitive& p = g_.primitives[node.payload];
+            double args[9] = {};
+            if (p.kind == PrimitiveKind::Torus || isTriangle(p.kind))
+                primitiveArgs(g_, n, EvalState{c.frame, c.path}, args);
+            if (isTriangle(p.kind)) {
+                Vec3 corners[3];
+                triangleCorners(p.kind, args, corners);
+                Boundary b;
+                if (!intersectTriangle(corners[0], corners[1], corners[2], r.o, r.d, tmin, tmax, b))
+                    return false;
+                hit = LocalHit{b.t, b.normal, c.material};
+                tmax = b.t;
+                return true;
+            }
+            Span s[kMaxPrimitiveSpans];
+            const int count = intersectSolid(p.kind, args, r.o, r.d, s);
+            for (int k = 0; k < count; ++k) {
+                const Boundary* b =
+                    s[k].in.t > tmin ? &s[k].in : (s[k].out.t > tmin ? &s[k].out : nullptr);
+                if (!b) continue;
+                if (!(b->t < tmax)) return false;
+                hit = LocalHit{b->t, b->normal, c.material};
+                tmax = b->t;
+                return true;
+            }
+            return false;
+        }
+    }
+    return false;
+}
+
+size_t Tracer::spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double tmax) {
+    ++visits_;
+    const Node& node = g_.nodes[n];
+    switch (node.kind) {
+        case NodeKind::Select: {
+            const uint32_t depth = c.depth + 1;
+            const EvalState st{c.frame, c.path};
+            try {
+                checkDepth(g_, n, depth, st);
+                checkStack();
+                if (scene_.useBounds) {
+                    double t0 = tmin, t1 = tmax;
+                    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r.o, r.d, t0, t1)) return 0;
+                }
+                const uint32_t rule = selectRule(g_, n, st);
+                const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
+                return spans(g_.child(n, rule), r, cc, tmin, tmax);
+            } catch (RuntimeError& e) {
+                e.enterModule(g_.modules[node.payload].name);
+                throw;
+            }
+        }
+        case NodeKind::Calc: {
+            double* f = frames_.push();
+            applyCalc(g_, n, EvalState{c.frame, c.path}, f);
+            const size_t count =
+                spans(g_.child(n), r, Ctx{f, c.path, c.depth, c.material}, tmin, tmax);
+            frames_.pop();
+            return count;
+        }
+        case NodeKind::Transform: {
+            NodeId target = scene_.target_[n];
+            Affine computed;
+            const Affine* inv = &scene_.inverse_[n];
+            if (target == kNone) {
+                computed = transformMatrix(g_, n, EvalState{c.frame, c.path}).inverse();
+                inv = &computed;
+                target = g_.child(n);
+            }
+            const LRay rr{inv->point(r.o), inv->vector(r.d)};
+            const size_t base = spans_.size();
+            const size_t count = spans(target, rr, c, tmin, tmax);
+            for (size_t k = base; k < base + count; ++k) {
+                spans_[k].in.normal = inv->transposedVector(spans_[k].in.normal);
+                spans_[k].out.normal = inv->transposedVector(spans_[k].out.normal);
+            }
+            return count;
+        }
+        case NodeKind::Paint:
+            return spans(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload}, tmin, tmax);
+        case NodeKind::Union:
+        case NodeKind::Intersection:
+        case NodeKind::Difference: {
+            const size_t base = spans_.size();
+            size_t acc = 0;
+            double lo = tmin, hi = tmax;
+            for (uint32_t i = 0; i < node.childCount; ++i) {
+                const NodeId child = g_.child(n, i);
+                double t0 = lo, t1 = hi;
+                const bool inBox =
+                    !scene_.useBounds || clipToBox(scene_.bounds_.node[child], r.o, r.d, t0, t1);
+                if (!inBox) {
+                    // Outside the window: empty there. An intersection becomes empty; the
+                    // first operand of a difference too.
+                    if (node.kind == NodeKind::Intersection || i == 0) {
+                        spans_.resize(base);
+                        return 0;
+                    }
+                    continue;
+                }
+                const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
+                const size_t cbase = base + acc;
+                const size_t count = spans(child, r, cc, lo, hi);
+                if (count == 0) {
+                    if (node.kind == NodeKind::Intersection ||
+                        (node.kind == NodeKind::Difference && i == 0)) {
+                        spans_.resize(base);
+                        return 0;
+                    }
+                    continue;
+                }
+                if (i == 0 || (node.kind == NodeKind::Union && acc == 0)) {
+                    acc = count;  // already at base
+                } else {
+                    // Combine [base, base+acc) with [cbase, cbase+count) above them, then
+                    // move the result down to base.
+                    const size_t rbase = cbase + count;
+                    spans_.resize(rbase + acc + count);
+                    Span* s = spans_.data();
+                    size_t m = 0;
+                    switch (node.kind) {
+                        case NodeKind::Union:
+                            m = uniteSpans(s + base, acc, s + cbase, count, s + rbase);
+                            break;
+                        case NodeKind::Intersection:
+                            m = intersectSpans(s + base, acc, s + cbase, count, s + rbase);
+                            break;
+                        default:
+                            m = subtractSpans(s + base, acc, s + cbase, count, s + rbase);
+                            break;
+                    }
+                    std::memmove(static_cast<void*>(s + base), s + rbase, m * sizeof(Span));
+                    acc = m;
+                    spans_.resize(base + acc);
+                    if (acc == 0 && node.kind != NodeKind::Union) return 0;
+                }
+                // ∩ and \ never grow beyond their first operand: narrow the window.
+                if (node.kind != NodeKind::Union) {
+                    lo = std::max(lo, spans_[base].in.t);
+                    hi = std::min(hi, spans_[base + acc - 1].out.t);
+                }
+            }
+            return acc;
+        }
+        case NodeKind::Primitive: {
+            const Primitive& p = g_.primitives[node.payload];
+            if (isTriangle(p.kind)) return 0;  // surfaces: never under ∩ or \ (the compiler checks)
+            double args[9] = {};
+            if (p.kind == PrimitiveKind::Torus)
+                primitiveArgs(g_, n, EvalState{c.frame, c.path}, args);
+            Span s[kMaxPrimitiveSpans];
+            const int count = intersectSolid(p.kind, args, r.o, r.d, s);
+            for (int k = 0; k < count; ++k) {
+                s[k].in.material = s[k].out.material = c.material;
+                spans_.push_back(s[k]);
+            }
+            return static_cast<size_t>(count);
+        }
+    }
+    return 0;
+}
+
+}  // namespace pcsg::tracer

@@ -1,0 +1,147 @@
+// Rays walk the cyclic graph directly, by the one semantics (eval.h): S-nodes select a
+// rule, C-nodes compute a new parameter frame for their subtree, T-nodes map the ray into
+// their child's frame by the inverse of their matrix, paint nodes set the material,
+// operators combine their children. The graph is never expanded.
+//
+//  - The ray's direction is not normalised in child frames, so its parameter t is the same
+//    number in every frame of the graph: distances compare across the whole walk.
+//  - Normals travel back up: each T-node on the way back multiplies the normal found
+//    below it by the transpose of its inverse matrix (the paper's matrix chain, kept on
+//    the call stack), so a normal arrives in world space correctly even through mirrors
+//    and shears.
+//  - First hit (camera, shadow and reflection rays): a union visits its children front to
+//    back by the entry of the ray into their hyper-bounding boxes and stops at the first
+//    child whose box starts beyond the nearest hit found so far. Only intersections and
+//    differences compute full span lists (span_list.h) of their operands, restricted to
+//    the window of t that still matters.
+//  - Hyper-bounding boxes (bounds.h) are tested at every S-node (with its per-depth box)
+//    and for every operand of an operator, in every cycle.
+//  - Memory per ray: parameter frames come from a per-thread stack of blocks, span lists
+//    from a per-thread vector used as a stack; nothing is allocated per ray once these
+//    have grown to the scene's needs.
+//  - Recursion: one C++ call per node visit. The depth of the walk is bounded by
+//    (max_depth + 1) times the longest S-free path of the graph (recursionBound()); the
+//    renderer runs the walk on threads whose stacks are sized from that bound
+//    (stackBytesNeeded()), and a guard at every S-node turns a stack that would still run
+//    out into a clear error instead of a crash.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "bounds.h"
+#include "eval.h"
+#include "graph.h"
+#include "primitives.h"
+
+namespace pcsg::tracer {
+
+struct SurfaceHit {
+    double t = 0;
+    Vec3 normal;  // world space, outward from the solid hit, not normalised
+    uint32_t material = 0;
+};
+
+// The graph with everything the walk precomputes once: boxes, inverses of constant
+// T-node matrices (fused along chains of constant T-nodes), the recursion bound.
+class TraceScene {
+  public:
+    TraceScene(const Graph& g, Bounds bounds);
+
+    const Graph& graph() const { return g_; }
+    const Bounds& bounds() const { return bounds_; }
+
+    // The largest number of nested node visits a walk can make (see above).
+    uint64_t recursionBound() const { return recursionBound_; }
+    // Stack bytes a thread needs to walk this graph (with a generous margin).
+    size_t stackBytesNeeded() const;
+
+    // Tests turn culling off to check that it never changes a result.
+    bool useBounds = true;
+
+  private:
+    friend class Tracer;
+    const Graph& g_;
+    Bounds bounds_;
+    std::vector<Affine> inverse_;  // per node: constant T-nodes (fused chain)
+    std::vector<NodeId> target_;   // per node: where a constant T-chain leads, else kNone
+    uint64_t recursionBound_ = 0;
+};
+
+// The stack ran out although the walk stays within max_depth (the thread's stack is
+// smaller than stackBytesNeeded()).
+class StackExhausted : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+// Per-thread walker: reuse one for all the rays of a thread.
+class Tracer {
+  public:
+    explicit Tracer(const TraceScene& scene);
+
+    // The nearest surface with tmin < t < tmax along origin + t dir (dir in world space;
+    // t is the distance when dir has unit length). Throws RuntimeError (with its module
+    // path) or StackExhausted.
+    bool firstHit(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
+
+    // Any surface with tmin < t < tmax (shadow rays): stops at the first one found.
+    bool anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tmax);
+
+    uint64_t nodeVisits() const { return visits_; }
+    // The lowest stack address a walk reached (for the stack-size test).
+    uintptr_t stackLowWater() const { return lowWater_; }
+
+  private:
+    struct LRay {
+        Vec3 o, d;
+    };
+    struct Ctx {
+        const double* frame;
+        uint64_t path;
+        uint32_t depth;
+        uint32_t material;
+    };
+    struct LocalHit {
+        double t;
+        Vec3 normal;
+        uint32_t material;
+    };
+
+    // Parameter frames: a stack of fixed-size blocks (addresses stay valid while deeper
+    // frames are pushed).
+    class FrameStack {
+      public:
+        explicit FrameStack(size_t frameSize);
+        double* push();
+        void pop() { --used_; }
+        void reset() { used_ = 0; }
+
+      private:
+        size_t frameSize_, perBlock_;
+        std::vector<std::unique_ptr<double[]>> blocks_;
+        size_t used_ = 0;
+    };
+
+    bool first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& tmax, LocalHit& hit);
+    size_t spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double tmax);
+    bool boundaryHit(size_t base, size_t count, double tmin, double tmax, LocalHit& hit);
+    bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
+    void checkStack();
+
+    const TraceScene& scene_;
+    const Graph& g_;
+    FrameStack frames_;
+    std::vector<double> rootFrame_;
+    std::vector<Span> spans_;
+    std::vector<std::pair<double, uint32_t>> order_;
+    bool anyHit_ = false;
+    uint64_t visits_ = 0;
+    uintptr_t stackLimit_ = 0;
+    uintptr_t lowWater_ = UINTPTR_MAX;
+};
+
+}  // namespace pcsg::tracer
