@@ -5,9 +5,8 @@
 // folded away (∪ drops it, ∩ with it is empty, A \ empty is A, empty \ B is empty) and
 // operators left with one operand replaced by that operand.
 //
-// Both the expansion and the counting pass use an explicit stack: no recursion on the
-// C++ stack, whatever the graph's depth (max_depth bounds the S-node depth, and between
-// two S-nodes a path is acyclic, so the stack is bounded by (max_depth + 1) * nodes).
+// Both the expansion and the counting pass are sinks of the shared walk (compiler/walk.h),
+// which uses an explicit stack: no recursion on the C++ stack, whatever the graph's depth.
 #pragma once
 
 #include <cstdint>
@@ -17,10 +16,9 @@
 #include <vector>
 
 #include "graph.h"
+#include "walk.h"  // TreeKind
 
 namespace pcsg {
-
-enum class TreeKind : uint8_t { Primitive, Union, Intersection, Difference };
 
 // One primitive of the expanded tree: its kind in its own coordinates (LANGUAGE.md
 // section 5), the accumulated object-to-world map, its material and its arguments.

@@ -1,0 +1,282 @@
+// The one walk that unrolls the cyclic graph: an explicit-stack traversal of every path
+// from a start node, following the one semantics of eval.h (selection, C-nodes, T-node
+// matrices, paint, instance paths and rand()). What it produces is up to a sink:
+//
+//  - povexport/expander.cpp: the expanded CSG tree, and the counting pass that sizes it;
+//  - tracer/instance_boxes.cpp: the exact bounding box of one S-node instance.
+//
+// No recursion on the C++ stack, whatever the graph's depth: max_depth bounds the
+// S-node depth, and between two S-nodes a path is acyclic, so the walk's own stack is
+// bounded by (max_depth + 1) * nodes.
+//
+// Sink interface (static):
+//   using Result;                        // what a sub-walk yields
+//   Result nothing();                    // the result of an empty walk
+//   void visit();                        // called once per node visit (work limits)
+//   bool lookup(NodeId, uint32_t depth, const double* frame, uint64_t path, Result&);
+//   void store(NodeId, uint32_t depth, const double* frame, uint64_t path, const Result&);
+//                                        // memoisation of S-node instances
+//   Result primitive(PrimitiveKind, const Affine& world, uint32_t material,
+//                    const double* args, uint32_t argc);
+//   void beginOperator(WalkEntry&);
+//   Result endOperator(TreeKind, const Result* operands, uint32_t n, const WalkEntry&);
+// and optionally, to see every S-node instance in its own frame:
+//   static constexpr bool kLocalSelectFrames = true;
+//   Result toParent(const Affine& selectToParent, const Result& local);
+// With kLocalSelectFrames the walk restarts `world` at the identity below each S-node,
+// lookup/store see results in the S-node's own frame, and toParent maps them into the
+// frame of the node that reached the S-node.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "eval.h"
+#include "graph.h"
+
+namespace pcsg {
+
+enum class TreeKind : uint8_t { Primitive, Union, Intersection, Difference };
+
+// The argument values a primitive kind carries into an expanded tree.
+constexpr uint32_t storedArgs(PrimitiveKind k) {
+    switch (k) {
+        case PrimitiveKind::Torus: return 2;
+        case PrimitiveKind::Triangle: return 9;
+        default: return 0;
+    }
+}
+
+// One node being visited: the traversal state the one semantics carries down.
+struct WalkEntry {
+    NodeId node;
+    uint32_t depth;       // S-nodes passed on the path before this node
+    uint32_t material;    // the innermost paint so far (0: default)
+    uint32_t next;        // progress: operators: children begun; unary nodes: 1 once entered
+    size_t frame;         // offset of the incoming parameter frame in the arena
+    size_t resultBase;    // size of the result stack when an operator began
+    uint64_t path;        // the instance path
+    Affine world;         // maps this node's frame to the start node's frame
+    size_t mark[4];       // the sink's bookkeeping for operators
+};
+
+// Where a walk starts: the axiom with an empty frame, or any node with a given state.
+struct WalkStart {
+    NodeId node = kNone;
+    const double* frame = nullptr;  // g.slotCount() values; nullptr: every slot unassigned
+    uint64_t path = kRootPath;
+    uint32_t depth = 0;
+    uint32_t material = 0;
+};
+
+template <class Sink>
+class Walker {
+public:
+    using Result = typename Sink::Result;
+
+    Walker(const Graph& g, Sink& sink)
+        : g_(g), sink_(sink), frameSize_(std::max<size_t>(g.slotCount(), 1)) {}
+
+    // Walks everything below the axiom.
+    Result run() {
+        WalkStart s;
+        s.node = g_.axiom;
+        return run(s);
+    }
+
+    // Walks everything below `start`. A RuntimeError gets the module path of the S-nodes
+    // on the walk's stack (the start node included when `annotateStart`).
+    Result run(const WalkStart& start, bool annotateStart = true) {
+        stack_.clear();
+        results_.clear();
+        if (start.node == kNone || start.node >= g_.nodes.size()) return sink_.nothing();
+        arena_.assign(frameSize_, 0.0);
+        if (start.frame)
+            std::copy(start.frame, start.frame + g_.slotCount(), arena_.begin());
+        else
+            initFrame(g_, arena_.data());
+        WalkEntry root{};
+        root.node = start.node;
+        root.depth = start.depth;
+        root.material = start.material;
+        root.path = start.path;
+        root.world = Affine::identity();
+        stack_.push_back(root);
+        try {
+            while (!stack_.empty()) step();
+        } catch (RuntimeError& e) {
+            // Every S-node on the stack, innermost first, so that enterModule (which
+            // prepends) leaves the outermost first.
+            for (size_t i = stack_.size(); i-- > (annotateStart ? 0 : 1);)
+                if (g_.nodes[stack_[i].node].kind == NodeKind::Select)
+                    e.enterModule(g_.modules[g_.nodes[stack_[i].node].payload].name);
+            throw;
+        }
+        return results_.back();
+    }
+
+private:
+    static constexpr bool localSelectFrames() {
+        if constexpr (requires { Sink::kLocalSelectFrames; })
+            return Sink::kLocalSelectFrames;
+        else
+            return false;
+    }
+
+    // The result of an S-node instance (in its own frame when localSelectFrames) as the
+    // node above it sees it.
+    Result fromSelect(const WalkEntry& e, const Result& r) {
+        if constexpr (localSelectFrames())
+            return sink_.toParent(e.world, r);
+        else
+            return r;
+    }
+
+    void step() {
+        WalkEntry& e = stack_.back();
+        const Node& node = g_.nodes[e.node];
+        switch (node.kind) {
+            case NodeKind::Select: {
+                if (e.next == 0) {
+                    sink_.visit();
+                    const EvalState st{arena_.data() + e.frame, e.path};
+                    Result memo;
+                    if (sink_.lookup(e.node, e.depth, st.frame, e.path, memo)) {
+                        Result r = fromSelect(e, memo);
+                        stack_.pop_back();
+                        results_.push_back(r);
+                        return;
+                    }
+                    const uint32_t depth = e.depth + 1;
+                    checkDepth(g_, e.node, depth, st);
+                    const uint32_t rule = selectRule(g_, e.node, st);
+                    e.next = 1;
+                    WalkEntry c = e;
+                    c.node = g_.child(e.node, rule);
+                    c.next = 0;
+                    c.depth = depth;
+                    c.path = pathRule(e.path, rule);
+                    if constexpr (localSelectFrames()) c.world = Affine::identity();
+                    stack_.push_back(c);
+                } else {
+                    sink_.store(e.node, e.depth, arena_.data() + e.frame, e.path, results_.back());
+                    results_.back() = fromSelect(e, results_.back());
+                    stack_.pop_back();
+                }
+                return;
+            }
+            case NodeKind::Calc: {
+                if (e.next == 0) {
+                    sink_.visit();
+                    const size_t off = arena_.size();
+                    arena_.resize(off + frameSize_);
+                    WalkEntry& cur = stack_.back();
+                    applyCalc(g_, cur.node, {arena_.data() + cur.frame, cur.path},
+                              arena_.data() + off);
+                    cur.next = 1;
+                    WalkEntry c = cur;
+                    c.node = g_.child(cur.node);
+                    c.next = 0;
+                    c.frame = off;
+                    stack_.push_back(c);
+                } else {
+                    // Frames are released in stack order: the child's is the last one.
+                    arena_.resize(arena_.size() - frameSize_);
+                    stack_.pop_back();
+                }
+                return;
+            }
+            case NodeKind::Transform: {
+                if (e.next == 0) {
+                    sink_.visit();
+                    const Affine m = transformMatrix(g_, e.node, {arena_.data() + e.frame, e.path});
+                    e.next = 1;
+                    WalkEntry c = e;
+                    c.node = g_.child(e.node);
+                    c.next = 0;
+                    c.world = e.world * m;
+                    stack_.push_back(c);
+                } else {
+                    stack_.pop_back();
+                }
+                return;
+            }
+            case NodeKind::Paint: {
+                if (e.next == 0) {
+                    sink_.visit();
+                    e.next = 1;
+                    WalkEntry c = e;
+                    c.node = g_.child(e.node);
+                    c.next = 0;
+                    c.material = node.payload;
+                    stack_.push_back(c);
+                } else {
+                    stack_.pop_back();
+                }
+                return;
+            }
+            case NodeKind::Union:
+            case NodeKind::Intersection:
+            case NodeKind::Difference: {
+                if (e.next == 0) {
+                    sink_.visit();
+                    e.resultBase = results_.size();
+                    sink_.beginOperator(e);
+                }
+                if (e.next < node.childCount) {
+                    const uint32_t i = e.next++;
+                    WalkEntry c = e;
+                    c.node = g_.child(e.node, i);
+                    c.next = 0;
+                    c.path = pathChild(e.path, i);
+                    stack_.push_back(c);
+                    return;
+                }
+                const TreeKind kind = node.kind == NodeKind::Union          ? TreeKind::Union
+                                      : node.kind == NodeKind::Intersection ? TreeKind::Intersection
+                                                                            : TreeKind::Difference;
+                const size_t base = e.resultBase;
+                const Result r = sink_.endOperator(kind, results_.data() + base,
+                                                   static_cast<uint32_t>(results_.size() - base), e);
+                results_.resize(base);
+                results_.push_back(r);
+                stack_.pop_back();
+                return;
+            }
+            case NodeKind::Primitive: {
+                sink_.visit();
+                const Primitive& p = g_.primitives[node.payload];
+                double args[9] = {};
+                const uint32_t argc = storedArgs(p.kind);
+                if (argc) primitiveArgs(g_, e.node, {arena_.data() + e.frame, e.path}, args);
+                results_.push_back(sink_.primitive(p.kind, e.world, e.material, args, argc));
+                stack_.pop_back();
+                return;
+            }
+        }
+    }
+
+    const Graph& g_;
+    Sink& sink_;
+    const size_t frameSize_;
+    std::vector<WalkEntry> stack_;
+    std::vector<double> arena_;
+    std::vector<Result> results_;
+};
+
+// What the sub-graph below each module's S-node depends on: the parameter slots that
+// any expression reachable from it reads, and whether it calls rand() or choose() (then
+// its instances depend on the instance path too). Memoising S-node instances by these
+// is exact: two instances of a module with the same values in `reads` (and, when
+// `usesPath`, the same path) unroll to the same sub-tree.
+struct ModuleDependencies {
+    bool analysed = false;  // false: the graph was too large to analyse (memoise nothing)
+    bool usesPath = false;
+    std::vector<Slot> reads;  // ascending
+};
+
+// One entry per module (Graph::modules).
+std::vector<ModuleDependencies> moduleDependencies(const Graph& g);
+
+}  // namespace pcsg
