@@ -1,0 +1,339 @@
+// Rendering: the image does not depend on the thread count or on culling, --aa averages
+// N x N samples, adaptive supersampling touches only pixels next to a contrast, run-time
+// errors of the scene come out of render() as one RuntimeError with its module path, and
+// deep recursion neither crashes nor overflows the stack.
+#include "render.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "bounds.h"
+#include "camera.h"
+#include "eval.h"
+#include "shading.h"
+#include "test_support.h"
+#include "traversal.h"
+
+namespace pcsg::tracer {
+namespace {
+
+using testing::compile;
+
+// A small scene with everything that costs rays: shadows from two lights, a reflective
+// floor, phong highlights, CSG and a recursive module.
+const char* kBusyScene = R"(
+camera     { location <-1.8, -5.4, 2.3>  look_at <0.1, 0.1, 0.0>  sky <0, 0, 1>  angle 40 }
+light      { position <12, -6, 8>  color <1, 1, 1> }
+light      { position <-12, -4, 5>  color <0.25, 0.28, 0.4> }
+background <0.1, 0.15, 0.3>
+material warm   { color <0.95, 0.55, 0.22>  ambient 0.12  diffuse 0.75  phong 0.35  phong_size 40 }
+material mirror { color <0.3, 0.3, 0.35>  ambient 0.1  diffuse 0.4  reflection 0.5 }
+material cut    { color <0.2, 0.6, 0.9>  phong 0.5  phong_size 10 }
+paint(mirror) move(0, 0, -1.05) plane ∪ paint(warm) {c = 3} S ∪
+paint(cut) move(1.6, 0.8, 0) (uscale(0.7) sphere \ move(0.3, -0.3, 0.3) uscale(0.5) cube)
+S if(c > 0, 2, 1)
+1: S -> tetrahedron
+2: S -> {c = c-1} ( move(0.5,0.5,0.5) uscale(0.5) S ∪ move(-0.5,-0.5,0.5) uscale(0.5) S ∪
+                    move(0.5,-0.5,-0.5) uscale(0.5) S ∪ move(-0.5,0.5,-0.5) uscale(0.5) S )
+)";
+
+RenderOptions small(int threads) {
+    RenderOptions o;
+    o.width = 72;
+    o.height = 54;
+    o.threads = threads;
+    return o;
+}
+
+bool sameBytes(const RenderResult& a, const RenderResult& b) {
+    return a.width == b.width && a.height == b.height && a.rgb.size() == b.rgb.size() &&
+           std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0;
+}
+
+size_t differingPixels(const RenderResult& a, const RenderResult& b) {
+    size_t n = 0;
+    for (size_t p = 0; p + 2 < a.rgb.size(); p += 3)
+        if (std::memcmp(&a.rgb[p], &b.rgb[p], 3 * sizeof(float)) != 0) ++n;
+    return n;
+}
+
+TEST(Render, SameBytesWhateverTheThreadCount) {
+    auto c = compile(kBusyScene);
+    ASSERT_TRUE(c->graph);
+    struct Mode {
+        const char* name;
+        int aa;
+        double adaptive;
+    };
+    for (const Mode& m : {Mode{"aa 1", 1, 0}, Mode{"aa 3", 3, 0}, Mode{"adaptive 0.1", 1, 0.1}}) {
+        RenderOptions o = small(1);
+        o.aa = m.aa;
+        o.adaptive = m.adaptive;
+        const RenderResult one = render(*c->graph, o);
+        ASSERT_EQ(one.rgb.size(), size_t(72 * 54 * 3));
+        for (int threads : {2, 3}) {
+            o.threads = threads;
+            const RenderResult many = render(*c->graph, o);
+            EXPECT_TRUE(sameBytes(one, many))
+                << m.name << ": " << differingPixels(one, many) << " pixels differ between 1 and "
+                << threads << " threads";
+        }
+    }
+}
+
+TEST(Render, CullingNeverChangesTheImage) {
+    auto c = compile(kBusyScene);
+    ASSERT_TRUE(c->graph);
+    RenderOptions o = small(2);
+    const RenderResult culled = render(*c->graph, o);
+    o.useBounds = false;
+    const RenderResult plain = render(*c->graph, o);
+    EXPECT_TRUE(sameBytes(culled, plain))
+        << differingPixels(culled, plain) << " pixels differ with culling turned off";
+    // And the scene is not trivial: several colours, not just the background.
+    size_t background = 0;
+    for (size_t p = 0; p < culled.rgb.size(); p += 3)
+        if (std::fabs(culled.rgb[p] - 0.1f) < 1e-6f && std::fabs(culled.rgb[p + 2] - 0.3f) < 1e-6f)
+            ++background;
+    EXPECT_LT(background, culled.rgb.size() / 3 / 2);
+}
+
+// A flat white quadrant (ambient 1, no diffuse: the same colour everywhere on it) on black,
+// its two edges through the centre of the image. The camera looks along +y from x = z = 0,
+// so the planes x = 0 and z = 0 project onto the centre column and the centre row: with an
+// odd image size, through the middle of their pixels.
+const char* kQuadrant = R"(
+camera     { location <0, -10, 0>  look_at <0, 0, 0>  sky <0, 0, 1>  angle 40 }
+background <0, 0, 0>
+material flat { color <1, 1, 1>  ambient 1  diffuse 0 }
+paint(flat) move(-5, 0, -5) scale(5, 1, 5) cube
+)";
+
+TEST(Render, AntialiasingAveragesTheSamples) {
+    auto c = compile(kQuadrant);
+    ASSERT_TRUE(c->graph);
+    const int w = 33, h = 9, cx = 16, cy = 4;
+    for (int aa : {2, 4}) {
+        RenderOptions o;
+        o.width = w;
+        o.height = h;
+        o.aa = aa;
+        o.threads = 2;
+        const RenderResult r = render(*c->graph, o);
+        auto at = [&](int x, int y) { return r.rgb[(static_cast<size_t>(y) * w + x) * 3]; };
+        // Even N: no sample lies on an edge, and exactly half of them are on each side.
+        EXPECT_EQ(at(0, h - 1), 1.0f) << "aa " << aa << ": inside the quadrant";
+        EXPECT_EQ(at(w - 1, 0), 0.0f) << "aa " << aa << ": background";
+        EXPECT_EQ(at(cx, h - 1), 0.5f) << "aa " << aa << ": half covered (vertical edge)";
+        EXPECT_EQ(at(0, cy), 0.5f) << "aa " << aa << ": half covered (horizontal edge)";
+        EXPECT_EQ(at(cx, cy), 0.25f) << "aa " << aa << ": a quarter covered (the corner)";
+        EXPECT_EQ(at(cx, 0), 0.0f) << "aa " << aa;
+        EXPECT_EQ(at(w - 1, cy), 0.0f) << "aa " << aa;
+        // All three channels alike (white).
+        const size_t p = (static_cast<size_t>(cy) * w + cx) * 3;
+        EXPECT_EQ(r.rgb[p + 1], r.rgb[p]);
+        EXPECT_EQ(r.rgb[p + 2], r.rgb[p]);
+    }
+}
+
+// POV-Ray's colour difference for +A (render.h): the sum of the absolute differences of
+// the channels after the gamma 2.5 encoding.
+double aaDistance(const float* a, const float* b) {
+    auto enc = [](double v) { return v > 0 ? std::pow(v, 1.0 / 2.5) : 0.0; };
+    double d = 0;
+    for (int k = 0; k < 3; ++k) d += std::fabs(enc(a[k]) - enc(b[k]));
+    return d;
+}
+
+TEST(Render, AdaptiveSupersamplingChangesOnlyPixelsNextToAContrast) {
+    auto c = compile(kBusyScene);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const double threshold = 0.3;
+    RenderOptions o = small(2);
+    const RenderResult centres = render(g, o);
+    o.adaptive = threshold;
+    const RenderResult adaptive = render(g, o);
+    const int w = o.width, h = o.height;
+
+    // The extra samples, as POV-Ray takes them: a 3 x 3 grid (no jitter), averaged with
+    // the centre sample.
+    TraceScene scene(g, computeBounds(g));
+    Shader shader(scene);
+    const PinholeCamera camera(g.scene.camera, w, h);
+    const int depth = 3;
+    const double step = 1.0 / depth, range = 0.5 - 0.5 * step;
+
+    int edges = 0, changed = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float* cp = &centres.rgb[(static_cast<size_t>(y) * w + x) * 3];
+            const float* ap = &adaptive.rgb[(static_cast<size_t>(y) * w + x) * 3];
+            bool contrast = false;
+            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+            for (int k = 0; k < 4; ++k) {
+                if (nx[k] < 0 || nx[k] >= w || ny[k] < 0 || ny[k] >= h) continue;
+                const float* q = &centres.rgb[(static_cast<size_t>(ny[k]) * w + nx[k]) * 3];
+                if (aaDistance(cp, q) >= threshold) contrast = true;
+            }
+            const bool differs = std::memcmp(cp, ap, 3 * sizeof(float)) != 0;
+            changed += differs;
+            if (!contrast) {
+                EXPECT_FALSE(differs) << "pixel (" << x << ", " << y
+                                      << ") changed without a contrast to its neighbours";
+                continue;
+            }
+            ++edges;
+            Vec3 sum{cp[0], cp[1], cp[2]};
+            for (int j = 0; j < depth; ++j)
+                for (int i = 0; i < depth; ++i)
+                    sum += shader.shade(
+                        camera.ray(x + 0.5 - range + i * step, y + 0.5 - range + j * step));
+            sum = sum / static_cast<double>(depth * depth + 1);
+            for (int k = 0; k < 3; ++k)
+                EXPECT_NEAR(ap[k], sum[k], 1e-6)
+                    << "pixel (" << x << ", " << y << ") channel " << k;
+        }
+    EXPECT_GT(edges, 50) << "the scene should have edges";
+    EXPECT_LT(edges, w * h / 2) << "too many edges for the test to say anything";
+    EXPECT_GT(changed, edges / 2) << "supersampling should change most edge pixels";
+}
+
+// The first RuntimeError a render meets, or a failure.
+RuntimeError renderError(const Graph& g, const RenderOptions& o) {
+    try {
+        render(g, o);
+    } catch (const RuntimeError& e) {
+        return e;
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "not a RuntimeError: " << e.what();
+        return RuntimeError({}, "");
+    }
+    ADD_FAILURE() << "render() did not throw";
+    return RuntimeError({}, "");
+}
+
+std::string joined(const std::vector<std::string>& path) {
+    std::string s;
+    for (const auto& m : path) s += (s.empty() ? "" : " ") + m;
+    return s;
+}
+
+size_t occurrences(const std::string& text, const std::string& what) {
+    size_t n = 0;
+    for (size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+    return n;
+}
+
+TEST(Render, RuleOutOfRangeIsOneRuntimeErrorWithItsModulePath) {
+    // Four steps of A, then B selects rule 7 of 1. B's part fills the view. Culling must not
+    // hide the error: every ray that enters the scene reaches B, with or without boxes.
+    auto c = compile(R"(
+camera { location <0, -6, 0>  look_at <0, 0, 0>  sky <0, 0, 1>  angle 60 }
+{n = 3} A
+A if(n > 0, 2, 1)
+1: A -> B
+2: A -> {n = n-1} move(0, 0, 0.01) A
+B if(n == 0, 7, 1)
+1: B -> uscale(2) sphere
+)");
+    ASSERT_TRUE(c->graph);
+    for (bool useBounds : {true, false})
+        for (int threads : {1, 3}) {
+            RenderOptions o;
+            o.width = 24;
+            o.height = 18;
+            o.threads = threads;
+            o.useBounds = useBounds;
+            const RuntimeError e = renderError(*c->graph, o);
+            EXPECT_NE(e.message.find("module B gave rule 7"), std::string::npos) << e.message;
+            EXPECT_EQ(joined(e.modulePath), "A A A A B")
+                << "culling " << useBounds << ", " << threads << " threads";
+            const std::string text = e.format(*c->graph);
+            EXPECT_EQ(occurrences(text, "module path"), 1u) << text;
+            EXPECT_EQ(occurrences(text, "error:"), 1u) << text;
+        }
+}
+
+TEST(Render, MaxDepthExceededIsOneRuntimeErrorWithItsModulePath) {
+    // A column of spheres that never ends.
+    auto c = compile(R"(
+settings { max_depth 12 }
+camera { location <0, -30, 6>  look_at <0, 0, 6>  sky <0, 0, 1>  angle 50 }
+{n = 0} A
+A 1
+1: A -> sphere ∪ {n = n+1} move(0, 0, 1) A
+)");
+    ASSERT_TRUE(c->graph);
+    for (bool useBounds : {true, false}) {
+        RenderOptions o;
+        o.width = 16;
+        o.height = 16;
+        o.threads = 2;
+        o.useBounds = useBounds;
+        const RuntimeError e = renderError(*c->graph, o);
+        EXPECT_NE(e.message.find("max_depth 12"), std::string::npos) << e.message;
+        EXPECT_EQ(e.modulePath, std::vector<std::string>(13, "A")) << joined(e.modulePath);
+        const std::string text = e.format(*c->graph);
+        EXPECT_EQ(occurrences(text, "module path"), 1u) << text;
+        EXPECT_NE(text.find("A (x13)"), std::string::npos) << text;
+    }
+}
+
+// A chain of `steps` S-nodes, each lifting the rest by a tiny step, ending in a sphere.
+std::string chain(int steps, int maxDepth) {
+    return "settings { max_depth " + std::to_string(maxDepth) + " }\n" +
+           "camera { location <0, -8, 0.5>  look_at <0, 0, 0.5>  sky <0, 0, 1>  angle 40 }\n" +
+           "background <0, 0, 1>\n" + "{n = " + std::to_string(steps) + "} A\n" +
+           "A if(n > 0, 2, 1)\n" + "1: A -> sphere\n" + "2: A -> {n = n-1} move(0, 0, 0.0002) A\n";
+}
+
+TEST(Render, DeepRecursionRendersWithoutOverflowingTheStack) {
+    // 4,900 nested S-nodes (and as many C- and T-nodes) on every ray that reaches the
+    // sphere: rendered on threads whose stacks are sized from the scene.
+    auto c = compile(chain(4900, 5000));
+    ASSERT_TRUE(c->graph);
+    RenderOptions o;
+    o.width = 12;
+    o.height = 12;
+    o.threads = 2;
+    RenderResult r;
+    try {
+        r = render(*c->graph, o);
+    } catch (const RuntimeError& e) {
+        // The only acceptable failure is the max_depth error, and that cannot happen here.
+        FAIL() << e.format(*c->graph);
+    }
+    // The sphere (lifted by 0.98) fills the middle of the image, white-ish, and
+    // the corners show the blue background.
+    const float* mid = &r.rgb[(6 * 12 + 6) * 3];
+    EXPECT_GT(mid[0], 0.05f);
+    EXPECT_EQ(r.rgb[0], 0.0f);
+    EXPECT_EQ(r.rgb[2], 1.0f);
+}
+
+TEST(Render, TooDeepRecursionIsTheMaxDepthError) {
+    // 6,000 steps where 5,000 are allowed: every ray that would reach the sphere meets the
+    // max_depth error first (culling included: it must not turn the error into a picture
+    // of nothing).
+    auto c = compile(chain(6000, 5000));
+    ASSERT_TRUE(c->graph);
+    for (bool useBounds : {true, false}) {
+        RenderOptions o;
+        o.width = 8;
+        o.height = 8;
+        o.threads = 2;
+        o.useBounds = useBounds;
+        const RuntimeError e = renderError(*c->graph, o);
+        EXPECT_NE(e.message.find("max_depth 5000"), std::string::npos)
+            << "culling " << useBounds << ": " << e.message;
+        EXPECT_EQ(e.modulePath.size(), 5001u) << "culling " << useBounds;
+    }
+}
+
+}  // namespace
+}  // namespace pcsg::tracer
