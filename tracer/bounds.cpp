@@ -24,6 +24,7 @@ struct Level {
     std::vector<std::array<Interval, 9>> args;       // per non-constant primitive
     std::vector<uint8_t> argsOk;
     std::vector<std::vector<uint32_t>> rules;        // per S-node (module index)
+    std::vector<uint8_t> mayFail;                    // per module: its selection may be an error
 };
 
 class Analysis {
@@ -119,6 +120,7 @@ private:
         l.args.resize(pCount_);
         l.argsOk.assign(pCount_, 0);
         l.rules.resize(g_.modules.size());
+        l.mayFail.assign(g_.modules.size(), 0);
         return l;
     }
 
@@ -132,7 +134,9 @@ private:
         rec.reached[n] = 1;
         switch (node.kind) {
             case NodeKind::Select: {
-                auto rules = reachableRules(g_, n, st);
+                bool fails = false;
+                auto rules = reachableRules(g_, n, st, &fails);
+                if (fails) rec.mayFail[moduleOf(n)] = 1;
                 for (uint32_t r : rules) push(g_.child(n, r), st);
                 auto& dst = rec.rules[moduleOf(n)];
                 for (uint32_t r : rules)
@@ -301,6 +305,8 @@ private:
         switch (node.kind) {
             case NodeKind::Primitive: return primitiveBoxAt(n, rec);
             case NodeKind::Select: {
+                // A run-time error is "there" too: a ray that reaches it must meet it.
+                if (rec.mayFail[moduleOf(n)]) return Box::everything();
                 Box b;
                 for (uint32_t r : rec.rules[moduleOf(n)]) b = unite(b, child(g_.child(n, r)));
                 return b;
@@ -331,7 +337,7 @@ private:
 
     // A candidate summary box, enlarged a little so that a converging iteration becomes a
     // post-fixpoint.
-    static Box enlarged(const Box& b) { return grow(b, 1e-6, 1e-9); }
+    static Box enlarged(const Box& b) { return growBox(b, 1e-6, 1e-9); }
 
     void summaryBoxes() {
         sumBox_.assign(n_, Box::empty());
@@ -381,7 +387,7 @@ private:
             std::fill(cur.begin(), cur.end(), Box::empty());
             auto child = [&](NodeId c) -> Box {
                 if (!isSelect(c)) return cur[c];
-                if (d + 1 > maxDepth) return Box::empty();
+                if (d + 1 > maxDepth) return Box::everything();  // the max_depth error
                 if (d + 1 >= levels_) return summary_ ? sumBox_[c] : Box::empty();
                 return out.depthBox[static_cast<size_t>(moduleOf(c)) * levels_ + d + 1];
             };
@@ -400,27 +406,29 @@ private:
     }
 
     // Padding against rounding: relative to the box's size and position.
-    static Box padded(const Box& b) { return grow(b, 1e-9, 1e-10); }
-
-    // b enlarged on every finite side by rel * (finite extent) + abs * max(|ends|, 1).
-    static Box grow(const Box& b, double rel, double abs) {
-        if (b.isEmpty()) return b;
-        Box r = b;
-        for (int i = 0; i < 3; ++i) {
-            const double lo = b.lo[i], hi = b.hi[i];
-            const double extent = std::isfinite(hi - lo) ? hi - lo : 0.0;
-            double big = 1.0;
-            if (std::isfinite(lo)) big = std::max(big, std::fabs(lo));
-            if (std::isfinite(hi)) big = std::max(big, std::fabs(hi));
-            const double m = rel * extent + abs * big;
-            r.lo[i] = lo - m;  // infinite ends stay infinite
-            r.hi[i] = hi + m;
-        }
-        return r;
-    }
+    static Box padded(const Box& b) { return paddedBox(b); }
 };
 
 }  // namespace
+
+// b enlarged on every finite side by rel * (finite extent) + abs * max(|ends|, 1).
+Box growBox(const Box& b, double rel, double abs) {
+    if (b.isEmpty()) return b;
+    Box r = b;
+    for (int i = 0; i < 3; ++i) {
+        const double lo = b.lo[i], hi = b.hi[i];
+        const double extent = std::isfinite(hi - lo) ? hi - lo : 0.0;
+        double big = 1.0;
+        if (std::isfinite(lo)) big = std::max(big, std::fabs(lo));
+        if (std::isfinite(hi)) big = std::max(big, std::fabs(hi));
+        const double m = rel * extent + abs * big;
+        r.lo[i] = lo - m;  // infinite ends stay infinite
+        r.hi[i] = hi + m;
+    }
+    return r;
+}
+
+Box paddedBox(const Box& b) { return growBox(b, 1e-9, 1e-10); }
 
 Bounds computeBounds(const Graph& g, const BoundsOptions& options) {
     return Analysis(g, options).run();

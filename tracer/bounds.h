@@ -21,6 +21,10 @@
 //    which is widened slightly and accepted only if it is a post-fixpoint (F(B) ⊆ B);
 //    nodes where that cannot be shown get an infinite box: nothing is ever culled that
 //    is there.
+//  - Run-time errors count as "there": an S-node whose selection may fail (a rule number
+//    out of range, no notation-B condition true) and an S-node reached beyond max_depth
+//    get an infinite box at that depth, so culling never turns an error into a picture
+//    of nothing. (Depths handled by the summary fixpoint do not track max_depth.)
 //  - A node's box is the union over its depths. S-nodes also keep their box per depth,
 //    which is tighter (the tracer knows the depth of every S-node it visits).
 //
@@ -66,5 +70,11 @@ struct BoundsOptions {
 };
 
 Bounds computeBounds(const Graph& g, const BoundsOptions& options = {});
+
+// b enlarged on every finite side by rel * (finite extent) + abs * max(|ends|, 1).
+Box growBox(const Box& b, double rel, double abs);
+// The padding every box the tracer tests gets, so that rounding in the ray's
+// transformation to a child frame never culls a surface that touches its box.
+Box paddedBox(const Box& b);
 
 }  // namespace pcsg::tracer

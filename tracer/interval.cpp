@@ -244,13 +244,21 @@ Interval callFunc(Func f, const Interval* a, uint32_t n, uint64_t seed) {
 
 // The interpreter: `if` and the short-circuit operators compile to jumps; when a
 // condition may be both zero and non-zero both continuations run and their results are
-// joined. `forks` bounds the work (beyond it, the result is everything).
+// joined. `forks` bounds the work (beyond it, the result is everything). With `leaves`
+// set, the result of every path through the code is also kept there, unjoined: a
+// selection `if(c, 2, if(d, 3, 1))` may give {1, 3} where the join says [1, 3].
 struct IntervalVm {
     const Graph& g;
     const AbstractFrame& frame;
     uint64_t seed;
     int forks = 0;
     static constexpr int kMaxForks = 64;
+    std::vector<Interval>* leaves = nullptr;
+
+    Interval leaf(const Interval& r) {
+        if (leaves) leaves->push_back(r);
+        return r;
+    }
 
     Interval run(uint32_t pc, uint32_t end, std::vector<Interval> stack) {
         const Instr* code = g.code.data();
@@ -310,7 +318,7 @@ struct IntervalVm {
                     const bool canJump = v.contains(0);
                     const bool canFall = v.nan || hasNonZero(v);
                     if (canJump && canFall) {
-                        if (++forks > kMaxForks) return Interval::all();
+                        if (++forks > kMaxForks) return leaf(Interval::all());
                         const Interval x = run(in.a, end, stack);
                         const Interval y = run(pc, end, stack);
                         return join(x, y);
@@ -336,7 +344,7 @@ struct IntervalVm {
             }
             if (!stack.empty() && stack.back().isBottom()) return Interval::bottom();
         }
-        return stack.empty() ? Interval::all() : stack.back();
+        return leaf(stack.empty() ? Interval::all() : stack.back());
     }
 };
 
@@ -417,16 +425,30 @@ bool applyCalcInterval(const Graph& g, NodeId n, const AbstractFrame& in, Abstra
     return true;
 }
 
-std::vector<uint32_t> reachableRules(const Graph& g, NodeId n, const AbstractFrame& frame) {
+std::vector<Interval> evalIntervalPaths(const Graph& g, ExprId e, const AbstractFrame& frame) {
+    const Expr& x = g.exprs[e];
+    std::vector<Interval> leaves;
+    IntervalVm vm{g, frame, g.scene.settings.seed};
+    vm.leaves = &leaves;
+    std::vector<Interval> stack;
+    stack.reserve(x.maxStack + 1);
+    vm.run(x.begin, x.end, std::move(stack));
+    return leaves;
+}
+
+std::vector<uint32_t> reachableRules(const Graph& g, NodeId n, const AbstractFrame& frame,
+                                     bool* mayFail) {
     const Module& m = g.modules[g.nodes[n].payload];
     const uint32_t rules = g.nodes[n].childCount;
     std::vector<uint32_t> out;
+    bool fails = false;
     if (m.notationB) {
         bool earlierMayFail = true;
         for (uint32_t i = 0; i < m.conditions.size() && i < rules && earlierMayFail; ++i) {
             const ExprId c = m.conditions[i];
             if (c == kNone) {
                 out.push_back(i);
+                earlierMayFail = false;
                 break;
             }
             const Interval v = evalInterval(g, c, frame);
@@ -434,14 +456,25 @@ std::vector<uint32_t> reachableRules(const Graph& g, NodeId n, const AbstractFra
             const bool canTrue = v.hasReals() && !(v.lo == 0 && v.hi == 0);
             const bool canFalse = v.contains(0);
             if (canTrue) out.push_back(i);
+            if (v.nan || v.lo == -Interval::kInf || v.hi == Interval::kInf) fails = true;
             earlierMayFail = canFalse;
         }
-        return out;
+        if (earlierMayFail) fails = true;  // no condition may hold
+    } else {
+        // Path by path, so that the rules of an if-chain stay a set.
+        std::vector<uint8_t> taken(rules, 0);
+        for (const Interval& v : evalIntervalPaths(g, m.select, frame)) {
+            if (v.nan) fails = true;
+            if (!v.hasReals()) continue;
+            const double lo = std::round(v.lo), hi = std::round(v.hi);
+            if (lo < 1 || hi > rules) fails = true;
+            for (double r = std::max(1.0, lo); r <= std::min<double>(rules, hi); r += 1)
+                taken[static_cast<uint32_t>(r) - 1] = 1;
+        }
+        for (uint32_t r = 0; r < rules; ++r)
+            if (taken[r]) out.push_back(r);
     }
-    const Interval v = evalInterval(g, m.select, frame);
-    if (!v.hasReals()) return out;
-    const double lo = std::max(1.0, std::round(v.lo)), hi = std::min<double>(rules, std::round(v.hi));
-    for (double r = lo; r <= hi; r += 1) out.push_back(static_cast<uint32_t>(r) - 1);
+    if (mayFail) *mayFail = fails;
     return out;
 }
 

@@ -57,12 +57,19 @@ AbstractFrame widen(const AbstractFrame& prev, const AbstractFrame& next);
 // the scene's, so that rand(x) of a known x is known.
 Interval evalInterval(const Graph& g, ExprId e, const AbstractFrame& frame);
 
+// The same, path by path: one interval per way through the expression's `if`s and
+// short-circuit operators (their union is evalInterval's result, up to the join).
+std::vector<Interval> evalIntervalPaths(const Graph& g, ExprId e, const AbstractFrame& frame);
+
 // A C-node on intervals: false when every evaluation fails (the child is unreachable).
 bool applyCalcInterval(const Graph& g, NodeId calcNode, const AbstractFrame& in,
                        AbstractFrame& out);
 
 // The rules (0-based) an S-node may select in the frame; empty when every selection fails.
-std::vector<uint32_t> reachableRules(const Graph& g, NodeId selectNode, const AbstractFrame& frame);
+// `mayFail`, when given, is set when the selection may be a run-time error for some values
+// in the frame (a rule number out of range or not finite, no notation-B condition true).
+std::vector<uint32_t> reachableRules(const Graph& g, NodeId selectNode, const AbstractFrame& frame,
+                                     bool* mayFail = nullptr);
 
 // An affine map whose entries are intervals: it stands for every matrix with entries in
 // them. transformBox applies all of them to a box (zero times an unbounded side is zero:
