@@ -8,12 +8,15 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
+#include <limits>
 
 #include "span_list.h"
 
 namespace pcsg::tracer {
 
 namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 #if defined(__SANITIZE_ADDRESS__)
 constexpr size_t kBytesPerVisit = 4096;
@@ -67,9 +70,13 @@ inline bool clipToBox(const Box& b, const Vec3& o, const Vec3& d, double& t0, do
 // ---------------------------------------------------------------------------------------
 // TraceScene
 
-TraceScene::TraceScene(const Graph& g, Bounds bounds) : g_(g), bounds_(std::move(bounds)) {
+TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
+                       const InstanceBoxOptions& instanceBoxOptions)
+    : g_(g), bounds_(std::move(bounds)) {
     const size_t n = g.nodes.size();
     if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
+    if (useInstanceBoxes && !g.modules.empty())
+        instanceBoxes_ = std::make_unique<InstanceBoxes>(g, bounds_, instanceBoxOptions);
     inverse_.assign(n, Affine::identity());
     target_.assign(n, kNone);
     auto constantT = [&](NodeId m) {
@@ -144,6 +151,20 @@ Tracer::Tracer(const TraceScene& scene)
     : scene_(scene), g_(scene.g_), frames_(scene.g_.slotCount()) {
     rootFrame_.assign(std::max<size_t>(g_.slotCount(), 1), 0.0);
     initFrame(g_, rootFrame_.data());
+    if (scene.instanceBoxes_) boxWorker_ = scene.instanceBoxes_->makeWorker();
+}
+
+// Whether the ray misses the S-node n (at `depth`) within [tmin, tmax]: its box at that
+// depth, then, where it pays, the exact box of this instance.
+bool Tracer::selectCulled(NodeId n, const LRay& r, const Ctx& c, uint32_t depth, double tmin,
+                          double tmax) {
+    if (!scene_.useBounds) return false;
+    double t0 = tmin, t1 = tmax;
+    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r.o, r.d, t0, t1)) return true;
+    const InstanceBoxes* boxes = scene_.instanceBoxes_.get();
+    if (!boxes || !boxes->useAt(n, depth)) return false;
+    const Box exact = boxes->box(*boxWorker_, n, depth, c.frame, c.path);
+    return !clipToBox(exact, r.o, r.d, t0, t1);
 }
 
 void Tracer::checkStack() {
@@ -167,7 +188,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
         double t0 = tmin, t1 = tmax;
         if (!clipToBox(scene_.bounds_.node[g_.axiom], origin, dir, t0, t1)) return false;
     }
-    LocalHit hit{};
+    LocalHit hit;
     double best = tmax;
     if (!first(g_.axiom, r, c, tmin, best, hit)) return false;
     out.t = hit.t;
@@ -188,8 +209,16 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
     return walk(origin, dir, tmin, tmax, hit);
 }
 
-// The first boundary of the span list at spans_[base, base + count) with tmin < t < tmax.
-bool Tracer::boundaryHit(size_t base, size_t count, double tmin, double tmax, LocalHit& hit) {
+// A surface at t from the instance `key` replaces the nearest one so far (at tmax)?
+// Nearer wins; at the same distance, the smaller instance path.
+static inline bool nearer(double t, uint64_t key, double tmax, const auto& hit) {
+    return t < tmax || (t == tmax && hit.valid && key < hit.key);
+}
+
+// The first boundary of the span list at spans_[base, base + count) with tmin < t < tmax
+// (or at tmax, winning the tie): becomes `hit`.
+bool Tracer::boundaryHit(size_t base, size_t count, double tmin, double tmax, uint64_t key,
+                         LocalHit& hit) {
     for (size_t k = 0; k < count; ++k) {
         const Span& s = spans_[base + k];
         const Boundary* b = nullptr;
@@ -199,10 +228,8 @@ bool Tracer::boundaryHit(size_t base, size_t count, double tmin, double tmax, Lo
             b = &s.out;
         else
             continue;
-        if (!(b->t < tmax)) return false;
-        hit.t = b->t;
-        hit.normal = b->normal;
-        hit.material = b->material;
+        if (!nearer(b->t, key, tmax, hit)) return false;
+        hit = LocalHit{b->t, b->normal, b->material, true, key};
         return true;
     }
     return false;
@@ -219,11 +246,7 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
             try {
                 checkDepth(g_, n, depth, st);
                 checkStack();
-                if (scene_.useBounds) {
-                    double t0 = tmin, t1 = tmax;
-                    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r.o, r.d, t0, t1))
-                        return false;
-                }
+                if (selectCulled(n, r, c, depth, tmin, tmax)) return false;
                 const uint32_t rule = selectRule(g_, n, st);
                 const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
                 return first(g_.child(n, rule), r, cc, tmin, tmax, hit);
@@ -272,7 +295,7 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
             bool found = false;
             for (size_t k = base; k < end; ++k) {
                 const auto [entry, i] = order_[k];
-                if (!(entry < tmax)) break;
+                if (entry > tmax) break;  // (at tmax exactly it may still win a tie)
                 const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
                 if (first(g_.child(n, i), r, cc, tmin, tmax, hit)) {
                     found = true;
@@ -286,7 +309,7 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
         case NodeKind::Difference: {
             const size_t base = spans_.size();
             const size_t count = spans(n, r, c, tmin, tmax);
-            const bool found = boundaryHit(base, count, tmin, tmax, hit);
+            const bool found = boundaryHit(base, count, tmin, tmax, c.path, hit);
             spans_.resize(base);
             if (found) tmax = hit.t;
             return found;
@@ -300,9 +323,12 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
                 Vec3 corners[3];
                 triangleCorners(p.kind, args, corners);
                 Boundary b;
-                if (!intersectTriangle(corners[0], corners[1], corners[2], r.o, r.d, tmin, tmax, b))
+                // (tmax widened by one step so that a tie can be seen)
+                if (!intersectTriangle(corners[0], corners[1], corners[2], r.o, r.d, tmin,
+                                       std::nextafter(tmax, kInfinity), b) ||
+                    !nearer(b.t, c.path, tmax, hit))
                     return false;
-                hit = LocalHit{b.t, b.normal, c.material};
+                hit = LocalHit{b.t, b.normal, c.material, true, c.path};
                 tmax = b.t;
                 return true;
             }
@@ -312,8 +338,8 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
                 const Boundary* b =
                     s[k].in.t > tmin ? &s[k].in : (s[k].out.t > tmin ? &s[k].out : nullptr);
                 if (!b) continue;
-                if (!(b->t < tmax)) return false;
-                hit = LocalHit{b->t, b->normal, c.material};
+                if (!nearer(b->t, c.path, tmax, hit)) return false;
+                hit = LocalHit{b->t, b->normal, c.material, true, c.path};
                 tmax = b->t;
                 return true;
             }
@@ -333,10 +359,7 @@ size_t Tracer::spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double 
             try {
                 checkDepth(g_, n, depth, st);
                 checkStack();
-                if (scene_.useBounds) {
-                    double t0 = tmin, t1 = tmax;
-                    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r.o, r.d, t0, t1)) return 0;
-                }
+                if (selectCulled(n, r, c, depth, tmin, tmax)) return 0;
                 const uint32_t rule = selectRule(g_, n, st);
                 const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
                 return spans(g_.child(n, rule), r, cc, tmin, tmax);
@@ -385,9 +408,10 @@ size_t Tracer::spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double 
                 const bool inBox =
                     !scene_.useBounds || clipToBox(scene_.bounds_.node[child], r.o, r.d, t0, t1);
                 if (!inBox) {
-                    // Outside the window: empty there. An intersection becomes empty; the
-                    // first operand of a difference too.
-                    if (node.kind == NodeKind::Intersection || i == 0) {
+                    // Outside the window: empty there. An intersection becomes empty, and
+                    // so does a difference whose first operand is.
+                    if (node.kind == NodeKind::Intersection ||
+                        (node.kind == NodeKind::Difference && i == 0)) {
                         spans_.resize(base);
                         return 0;
                     }

@@ -15,7 +15,13 @@
 //    differences compute full span lists (span_list.h) of their operands, restricted to
 //    the window of t that still matters.
 //  - Hyper-bounding boxes (bounds.h) are tested at every S-node (with its per-depth box)
-//    and for every operand of an operator, in every cycle.
+//    and for every operand of an operator, in every cycle. Where the static boxes are
+//    loose, an S-node also tests the exact box of the instance at hand
+//    (instance_boxes.h: a lazily filled, memory-bounded cache).
+//  - Ties: of two surfaces at exactly the same distance, the one with the smaller
+//    instance path wins, whatever the order the walk found them in. So the image does
+//    not depend on which boxes culled what (and the instance boxes' decisions depend on
+//    the order threads fill the cache).
 //  - Memory per ray: parameter frames come from a per-thread stack of blocks, span lists
 //    from a per-thread vector used as a stack; nothing is allocated per ray once these
 //    have grown to the scene's needs.
@@ -33,6 +39,7 @@
 #include <vector>
 
 #include "bounds.h"
+#include "instance_boxes.h"
 #include "eval.h"
 #include "graph.h"
 #include "primitives.h"
@@ -49,7 +56,8 @@ struct SurfaceHit {
 // T-node matrices (fused along chains of constant T-nodes), the recursion bound.
 class TraceScene {
   public:
-    TraceScene(const Graph& g, Bounds bounds);
+    TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes = true,
+               const InstanceBoxOptions& instanceBoxOptions = {});
 
     const Graph& graph() const { return g_; }
     const Bounds& bounds() const { return bounds_; }
@@ -62,6 +70,9 @@ class TraceScene {
     // Tests turn culling off to check that it never changes a result.
     bool useBounds = true;
 
+    // The exact boxes of instances (nullptr: static boxes only).
+    const InstanceBoxes* instanceBoxes() const { return instanceBoxes_.get(); }
+
   private:
     friend class Tracer;
     const Graph& g_;
@@ -69,6 +80,7 @@ class TraceScene {
     std::vector<Affine> inverse_;  // per node: constant T-nodes (fused chain)
     std::vector<NodeId> target_;   // per node: where a constant T-chain leads, else kNone
     uint64_t recursionBound_ = 0;
+    std::unique_ptr<InstanceBoxes> instanceBoxes_;
 };
 
 // The stack ran out although the walk stays within max_depth (the thread's stack is
@@ -106,9 +118,11 @@ class Tracer {
         uint32_t material;
     };
     struct LocalHit {
-        double t;
+        double t = 0;
         Vec3 normal;
-        uint32_t material;
+        uint32_t material = 0;
+        bool valid = false;  // a surface was found
+        uint64_t key = 0;    // the instance path of what was hit: breaks ties in t
     };
 
     // Parameter frames: a stack of fixed-size blocks (addresses stay valid while deeper
@@ -128,13 +142,17 @@ class Tracer {
 
     bool first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& tmax, LocalHit& hit);
     size_t spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double tmax);
-    bool boundaryHit(size_t base, size_t count, double tmin, double tmax, LocalHit& hit);
+    bool boundaryHit(size_t base, size_t count, double tmin, double tmax, uint64_t key,
+                     LocalHit& hit);
+    bool selectCulled(NodeId n, const LRay& r, const Ctx& c, uint32_t depth, double tmin,
+                      double tmax);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
     void checkStack();
 
     const TraceScene& scene_;
     const Graph& g_;
     FrameStack frames_;
+    InstanceBoxes::WorkerPtr boxWorker_;
     std::vector<double> rootFrame_;
     std::vector<Span> spans_;
     std::vector<std::pair<double, uint32_t>> order_;

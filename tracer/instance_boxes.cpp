@@ -1,0 +1,325 @@
+// Exact boxes of S-node instances: see instance_boxes.h.
+#include "instance_boxes.h"
+
+#include <tbb/spin_rw_mutex.h>
+
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "primitives.h"
+
+namespace pcsg::tracer {
+
+namespace {
+
+// SplitMix64's finaliser: parameter values are often dyadic fractions whose low bits
+// are all zero, which a multiplicative hash alone would not spread.
+inline uint64_t mix(uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+// A double rounded to a float towards -inf or +inf (the stored boxes only ever grow).
+inline float down(double x) {
+    float f = static_cast<float>(x);
+    if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    return f;
+}
+inline float up(double x) {
+    float f = static_cast<float>(x);
+    if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+    return f;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// The table: shards of open-addressing arrays, each behind a reader-writer lock.
+
+class InstanceBoxes::Table {
+  public:
+    struct Slot {
+        uint64_t a = 0, b = 0;  // the key; a == 0 && b == 0: empty
+        float lo[3], hi[3];
+        uint32_t weight = 0;
+    };
+
+    explicit Table(size_t maxBytes) : maxBytes_(maxBytes) {}
+
+    bool find(const Key& k, Stored& out) const {
+        const Shard& s = shard(k);
+        tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
+        if (s.slots.empty()) return false;
+        const size_t mask = s.slots.size() - 1;
+        for (size_t i = k.b & mask;; i = (i + 1) & mask) {
+            const Slot& slot = s.slots[i];
+            if (slot.a == 0 && slot.b == 0) return false;
+            if (slot.a == k.a && slot.b == k.b) {
+                for (int j = 0; j < 3; ++j) {
+                    out.box.lo[j] = slot.lo[j];
+                    out.box.hi[j] = slot.hi[j];
+                }
+                out.weight = slot.weight;
+                return true;
+            }
+        }
+    }
+
+    void insert(const Key& k, const Stored& st) {
+        Shard& s = shard(k);
+        tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
+        if ((s.count + 1) * 4 > s.slots.size() * 3 && !grow(s)) return;
+        const size_t mask = s.slots.size() - 1;
+        for (size_t i = k.b & mask;; i = (i + 1) & mask) {
+            Slot& slot = s.slots[i];
+            if (slot.a == k.a && slot.b == k.b) return;  // another thread was first
+            if (slot.a == 0 && slot.b == 0) {
+                slot.a = k.a;
+                slot.b = k.b;
+                for (int j = 0; j < 3; ++j) {
+                    slot.lo[j] = down(st.box.lo[j]);
+                    slot.hi[j] = up(st.box.hi[j]);
+                }
+                slot.weight = static_cast<uint32_t>(std::min<uint64_t>(st.weight, UINT32_MAX));
+                ++s.count;
+                entries_.fetch_add(1, std::memory_order_relaxed);
+                return;
+            }
+        }
+    }
+
+    uint64_t entries() const { return entries_.load(std::memory_order_relaxed); }
+    uint64_t bytes() const { return bytes_.load(std::memory_order_relaxed); }
+    bool full() const { return full_.load(std::memory_order_relaxed); }
+
+  private:
+    static constexpr size_t kShards = 64;
+    struct alignas(64) Shard {
+        mutable tbb::spin_rw_mutex mutex;
+        std::vector<Slot> slots;  // size 0 or a power of two
+        size_t count = 0;
+    };
+
+    Shard& shard(const Key& k) { return shards_[k.a % kShards]; }
+    const Shard& shard(const Key& k) const { return shards_[k.a % kShards]; }
+
+    // Doubles a shard's array (under its write lock), within the byte limit.
+    bool grow(Shard& s) {
+        const size_t size = s.slots.empty() ? 64 : s.slots.size() * 2;
+        const size_t added = (size - s.slots.size()) * sizeof(Slot);
+        size_t now = bytes_.load(std::memory_order_relaxed);
+        do {
+            if (now + added > maxBytes_) {
+                full_.store(true, std::memory_order_relaxed);
+                return false;
+            }
+        } while (!bytes_.compare_exchange_weak(now, now + added, std::memory_order_relaxed));
+        std::vector<Slot> old = std::move(s.slots);
+        s.slots.assign(size, Slot{});
+        const size_t mask = size - 1;
+        for (const Slot& o : old) {
+            if (o.a == 0 && o.b == 0) continue;
+            size_t i = o.b & mask;
+            while (s.slots[i].a != 0 || s.slots[i].b != 0) i = (i + 1) & mask;
+            s.slots[i] = o;
+        }
+        return true;
+    }
+
+    const size_t maxBytes_;
+    Shard shards_[kShards];
+    std::atomic<uint64_t> entries_{0}, bytes_{0};
+    std::atomic<bool> full_{false};
+};
+
+// ---------------------------------------------------------------------------------------
+// Unrolling one instance: a sink of the shared walk that unites primitive boxes.
+
+struct BoxResult {
+    Box box;
+    uint64_t weight = 0;
+};
+
+class BoxSink {
+  public:
+    using Result = BoxResult;
+    static constexpr bool kLocalSelectFrames = true;
+
+    explicit BoxSink(const InstanceBoxes& boxes) : boxes_(boxes) {}
+
+    void reset() {
+        visits_ = 0;
+        starts_.clear();
+    }
+
+    Result nothing() const { return {}; }
+    void visit() { ++visits_; }
+
+    // An S-node instance met inside the one being unrolled.
+    bool lookup(NodeId n, uint32_t, const double* frame, uint64_t path, Result& out) {
+        InstanceBoxes::Stored s;
+        if (boxes_.find(boxes_.keyOf(n, frame, path), s)) {
+            out = {s.box, s.weight};
+            visits_ += s.weight;  // it stands for that many visits
+            return true;
+        }
+        starts_.push_back(visits_);
+        return false;
+    }
+    void store(NodeId n, uint32_t, const double* frame, uint64_t path, Result& r) {
+        // Every visit below this S-node, including the ones its stored parts stand for.
+        r.weight = visits_ - starts_.back();
+        starts_.pop_back();
+        if (r.weight >= boxes_.opt_.minWeight)
+            boxes_.insert(boxes_.keyOf(n, frame, path), InstanceBoxes::Stored{r.box, r.weight});
+    }
+
+    Result toParent(const Affine& m, const Result& local) const {
+        return {transformBox(m, local.box), local.weight};
+    }
+
+    Result primitive(PrimitiveKind kind, const Affine& world, uint32_t, const double* args,
+                     uint32_t) const {
+        if (kind == PrimitiveKind::Empty) return {};
+        return {transformBox(world, primitiveBox(kind, args)), 1};
+    }
+
+    void beginOperator(WalkEntry&) {}
+
+    Result endOperator(TreeKind kind, const Result* r, uint32_t n, const WalkEntry&) const {
+        Result out;
+        if (n == 0) return out;
+        switch (kind) {
+            case TreeKind::Intersection:
+                out.box = r[0].box;
+                for (uint32_t i = 1; i < n; ++i) out.box = intersect(out.box, r[i].box);
+                break;
+            case TreeKind::Difference:
+                out.box = r[0].box;  // A \ B lies inside A
+                break;
+            default:
+                for (uint32_t i = 0; i < n; ++i) out.box.extend(r[i].box);
+                break;
+        }
+        if (out.box.isEmpty()) out.box = Box::empty();
+        return out;
+    }
+
+  private:
+    const InstanceBoxes& boxes_;
+    uint64_t visits_ = 0;
+    std::vector<uint64_t> starts_;  // visits_ when each open S-node instance began
+};
+
+class InstanceBoxes::Worker {
+  public:
+    explicit Worker(const InstanceBoxes& boxes) : sink(boxes), walker(boxes.g_, sink) {}
+    BoxSink sink;
+    Walker<BoxSink> walker;
+};
+
+// ---------------------------------------------------------------------------------------
+
+InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds, const InstanceBoxOptions& options)
+    : g_(g),
+      bounds_(bounds),
+      opt_(options),
+      deps_(moduleDependencies(g)),
+      table_(std::make_unique<Table>(options.maxBytes)),
+      levels_(g.scene.settings.maxDepth + 2) {
+    const size_t n = g.modules.size() * static_cast<size_t>(levels_);
+    decision_ = std::make_unique<std::atomic<uint8_t>[]>(n);
+    tried_ = std::make_unique<std::atomic<uint32_t>[]>(n);
+    paid_ = std::make_unique<std::atomic<uint32_t>[]>(n);
+    for (size_t i = 0; i < n; ++i) {
+        // Modules whose dependencies could not be analysed cannot be keyed: static only.
+        const bool analysed = deps_[i / levels_].analysed;
+        decision_[i].store(analysed ? 0 : 2, std::memory_order_relaxed);
+        tried_[i].store(0, std::memory_order_relaxed);
+        paid_[i].store(0, std::memory_order_relaxed);
+    }
+}
+
+InstanceBoxes::~InstanceBoxes() = default;
+
+InstanceBoxes::WorkerPtr InstanceBoxes::makeWorker() const { return WorkerPtr(new Worker(*this)); }
+
+void InstanceBoxes::WorkerDeleter::operator()(Worker* w) const { delete w; }
+
+bool InstanceBoxes::useAt(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return false;
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    return decision_[i].load(std::memory_order_relaxed) != 2;
+}
+
+InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint64_t path) const {
+    const ModuleDependencies& d = deps_[g_.nodes[select].payload];
+    uint64_t a = mix(0x84222325cbf29ce4ULL ^ select), b = mix(0x2545f4914f6cdd1dULL + select);
+    for (Slot s : d.reads) {
+        const uint64_t v = std::bit_cast<uint64_t>(frame[s]);
+        a = mix(a ^ v);
+        b = mix(b + v * 0x9e3779b97f4a7c15ULL);
+    }
+    if (d.usesPath) {
+        a = mix(a ^ path);
+        b = mix(b + path * 0xc2b2ae3d27d4eb4fULL);
+    }
+    return {a | 1, b};  // a != 0: never the empty slot
+}
+
+bool InstanceBoxes::find(const Key& k, Stored& out) const { return table_->find(k, out); }
+void InstanceBoxes::insert(const Key& k, const Stored& s) const { table_->insert(k, s); }
+
+// The trial of exact boxes at (module, depth): do they pay?
+void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const {
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    if (decision_[i].load(std::memory_order_relaxed) != 0) return;
+    bool pays = false;
+    if (s.weight >= opt_.minWeight) {
+        const Box& fixed = bounds_.select(g_, select, depth);
+        if (s.box.isEmpty() && !fixed.isEmpty()) pays = true;
+        for (int a = 0; a < 3 && !pays; ++a) {
+            const double exact = s.box.hi[a] - s.box.lo[a], whole = fixed.hi[a] - fixed.lo[a];
+            pays = !std::isfinite(whole) || exact < opt_.gain * whole;
+        }
+    }
+    if (pays) paid_[i].fetch_add(1, std::memory_order_relaxed);
+    const uint32_t tried = tried_[i].fetch_add(1, std::memory_order_relaxed) + 1;
+    if (tried >= opt_.trial) {
+        const uint32_t paid = paid_[i].load(std::memory_order_relaxed);
+        decision_[i].store(paid * 2 >= tried ? 1 : 2, std::memory_order_relaxed);
+    }
+}
+
+Box InstanceBoxes::box(Worker& w, NodeId select, uint32_t depth, const double* frame,
+                       uint64_t path) const {
+    const Key k = keyOf(select, frame, path);
+    Stored s;
+    if (!table_->find(k, s)) {
+        computed_.fetch_add(1, std::memory_order_relaxed);
+        w.sink.reset();
+        WalkStart start;
+        start.node = select;
+        start.frame = frame;
+        start.path = path;
+        start.depth = depth > 0 ? depth - 1 : 0;  // the walk counts this S-node itself
+        const BoxResult r = w.walker.run(start, /*annotateStart=*/false);
+        s.box = r.box;
+        s.weight = r.weight;
+    }
+    record(select, depth, s);
+    return paddedBox(s.box);
+}
+
+InstanceBoxStats InstanceBoxes::stats() const {
+    InstanceBoxStats st;
+    st.entries = table_->entries();
+    st.bytes = table_->bytes();
+    st.computed = computed_.load(std::memory_order_relaxed);
+    st.full = table_->full();
+    return st;
+}
+
+}  // namespace pcsg::tracer

@@ -1,0 +1,120 @@
+// Exact boxes of S-node instances: the tracer's lazily filled, memory-bounded cache of
+// what sub-graph instances hold (the seed paper's future-work "state grid", reduced to
+// what culling needs).
+//
+// The hyper-bounding boxes (bounds.h) hold for every instance of a node at once. Where
+// the instances differ a lot, they are loose: the terrain's heights travel in parameters,
+// so the static box of every sub-triangle spans the whole terrain's height, and a ray
+// that grazes the terrain enters thousands of them. The box of one instance, though, is
+// a function of the instance alone: of its S-node, the values of the parameters its
+// sub-graph reads, and, when the sub-graph calls rand() or choose(), its instance path
+// (walk.h's ModuleDependencies). So the tracer asks this cache for an instance's box.
+// A miss unrolls the instance through the shared walk (compiler/walk.h: the same code
+// the expander uses), uniting the boxes of its primitives; the S-node instances met on
+// the way are looked up and stored too, so filling the boxes of a whole object costs one
+// expansion of it, not one per level.
+//
+//  - Boxes are composed level by level: an instance's box is built from the boxes of
+//    the S-node instances inside it, each mapped by the matrices between the two
+//    S-nodes. That is exact for translations and scales, and for rotations encloses the
+//    rotated box; it is the same number whether the inner boxes came from the cache or
+//    were computed again, so culling never depends on the cache's history.
+//  - Only instances whose sub-graph took at least `minWeight` node visits to unroll are
+//    stored (smaller ones are cheaper to recompute than to keep); the table stops
+//    growing at `maxBytes`. Keys are 128-bit hashes of the instance.
+//  - Per (module, depth) the cache watches whether the exact boxes are worth it: when
+//    the first instances at a depth are all small, or all about as large as the static
+//    box there (a contractive system like the Sierpinski tetrahedron, whose static boxes
+//    are already exact), that depth goes back to the static box alone. Culling with a
+//    looser box is still sound and the tracer breaks ties between equally near hits by
+//    their instance path, so images do not depend on these decisions.
+//  - Thread-safe: shards with reader-writer locks; any number of tracers share one.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "bounds.h"
+#include "geometry.h"
+#include "graph.h"
+#include "walk.h"
+
+namespace pcsg::tracer {
+
+struct InstanceBoxOptions {
+    size_t maxBytes = 64u << 20;  // the table's size limit
+    uint64_t minWeight = 48;      // store instances whose unrolling took this many visits
+    // Per (module, depth): decide after this many computed instances whether exact boxes
+    // pay there.
+    uint32_t trial = 24;
+    // An exact box "pays" when it is smaller than the static box by this factor along
+    // some axis.
+    double gain = 0.8;
+};
+
+struct InstanceBoxStats {
+    uint64_t entries = 0;
+    uint64_t bytes = 0;
+    uint64_t computed = 0;  // instances unrolled on a miss
+    bool full = false;      // the table reached maxBytes
+};
+
+class InstanceBoxes {
+  public:
+    InstanceBoxes(const Graph& g, const Bounds& bounds, const InstanceBoxOptions& options = {});
+    ~InstanceBoxes();
+    InstanceBoxes(const InstanceBoxes&) = delete;
+    InstanceBoxes& operator=(const InstanceBoxes&) = delete;
+
+    // Whether exact boxes are used for this S-node at this depth (see above).
+    bool useAt(NodeId select, uint32_t depth) const;
+
+    // What a thread needs to unroll instances (the walk's stacks): one per thread.
+    class Worker;
+    struct WorkerDeleter {
+        void operator()(Worker* w) const;
+    };
+    using WorkerPtr = std::unique_ptr<Worker, WorkerDeleter>;
+    WorkerPtr makeWorker() const;
+
+    // The box of the S-node instance (select, frame, path) in the S-node's own frame,
+    // padded like every box the tracer tests. Throws RuntimeError (without this S-node
+    // in its module path: the caller adds it) when unrolling meets a run-time error.
+    Box box(Worker& w, NodeId select, uint32_t depth, const double* frame, uint64_t path) const;
+
+    InstanceBoxStats stats() const;
+
+  private:
+    friend class BoxSink;
+    struct Key {
+        uint64_t a = 0, b = 0;
+        bool operator==(const Key&) const = default;
+    };
+    struct Stored {
+        Box box;
+        uint64_t weight = 0;
+    };
+    class Table;
+
+    Key keyOf(NodeId select, const double* frame, uint64_t path) const;
+    bool find(const Key& k, Stored& out) const;
+    void insert(const Key& k, const Stored& s) const;
+    void record(NodeId select, uint32_t depth, const Stored& s) const;
+
+    const Graph& g_;
+    const Bounds& bounds_;
+    InstanceBoxOptions opt_;
+    std::vector<ModuleDependencies> deps_;
+    std::unique_ptr<Table> table_;
+    mutable std::atomic<uint64_t> computed_{0};
+
+    // Per (module, depth < levels_): 0 undecided, 1 use exact boxes, 2 static only; and
+    // the trial counters.
+    uint32_t levels_ = 0;
+    mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_;
+    mutable std::unique_ptr<std::atomic<uint32_t>[]> tried_, paid_;
+};
+
+}  // namespace pcsg::tracer
