@@ -1,8 +1,11 @@
-// Running another program (POV-Ray, or pcsg itself for a measured native render) and
-// measuring it: exit status, wall time and the child's own peak resident set size.
+// Running another program (POV-Ray, pcsg itself for a measured native render, or the
+// pcsg-image helper) and measuring it: exit status, wall time and the child's peak
+// resident set size.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -13,12 +16,27 @@ struct ChildResult {
     int exitCode = -1;      // -1 when killed by a signal
     int signal = 0;
     double seconds = 0;     // wall time
+    // The child's peak RSS as wait4 reports it (Linux): the largest of the child's own,
+    // that of any descendant it waited for (a `pcsg render` that ran pcsg-image reports
+    // the larger of the two; `pcsg render --json` prints its own as "peak_rss_bytes"),
+    // and this process's RSS when the child started: posix_spawn's child runs in this
+    // process's memory until its exec, and exec records that memory's peak as the
+    // child's. So a small parent matters for honest figures.
     uint64_t peakRssBytes = 0;
     std::string out, err;   // captured standard output and error
+    // With input: how many of its bytes the child took before it exited or closed its
+    // standard input (all of them unless it stopped reading early).
+    size_t inputWritten = 0;
 };
 
 // Runs argv[0] (searched in PATH) with the arguments, standard input from /dev/null.
 ChildResult runChild(const std::vector<std::string>& argv);
+
+// Runs argv[0] likewise with `input` on its standard input, through a pipe: writes all of
+// it, closes the pipe, then waits. A child that exits (or dies) before it has read
+// everything ends the writing early (no SIGPIPE reaches this process); inputWritten says
+// how far it got. The child's output goes to files, so it cannot block the writing.
+ChildResult runChild(const std::vector<std::string>& argv, std::span<const std::byte> input);
 
 // The absolute path of the running executable (to run pcsg's own subcommands).
 std::string selfExecutable();
