@@ -33,6 +33,19 @@ inline float up(double x) {
     return f;
 }
 
+// A box as the table stores it (floats, rounded outwards). Every instance box is rounded
+// so, stored or not, so that a box built from inner boxes is the same number whether
+// they came from the table or were computed again.
+inline Box storable(const Box& b) {
+    if (b.isEmpty()) return Box::empty();
+    Box r;
+    for (int j = 0; j < 3; ++j) {
+        r.lo[j] = down(b.lo[j]);
+        r.hi[j] = up(b.hi[j]);
+    }
+    return r;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -78,9 +91,9 @@ class InstanceBoxes::Table {
             if (slot.a == 0 && slot.b == 0) {
                 slot.a = k.a;
                 slot.b = k.b;
-                for (int j = 0; j < 3; ++j) {
-                    slot.lo[j] = down(st.box.lo[j]);
-                    slot.hi[j] = up(st.box.hi[j]);
+                for (int j = 0; j < 3; ++j) {  // (exact: the box is storable())
+                    slot.lo[j] = static_cast<float>(st.box.lo[j]);
+                    slot.hi[j] = static_cast<float>(st.box.hi[j]);
                 }
                 slot.weight = static_cast<uint32_t>(std::min<uint64_t>(st.weight, UINT32_MAX));
                 ++s.count;
@@ -172,6 +185,7 @@ class BoxSink {
         // Every visit below this S-node, including the ones its stored parts stand for.
         r.weight = visits_ - starts_.back();
         starts_.pop_back();
+        r.box = storable(r.box);
         if (r.weight >= boxes_.opt_.minWeight)
             boxes_.insert(boxes_.keyOf(n, frame, path), InstanceBoxes::Stored{r.box, r.weight});
     }

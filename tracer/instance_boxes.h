@@ -17,8 +17,9 @@
 //  - Boxes are composed level by level: an instance's box is built from the boxes of
 //    the S-node instances inside it, each mapped by the matrices between the two
 //    S-nodes. That is exact for translations and scales, and for rotations encloses the
-//    rotated box; it is the same number whether the inner boxes came from the cache or
-//    were computed again, so culling never depends on the cache's history.
+//    rotated box. Every instance box is rounded outwards to floats (as the table stores
+//    it), so it is the same number whether the inner boxes came from the cache or were
+//    computed again: culling never depends on the cache's history.
 //  - Only instances whose sub-graph took at least `minWeight` node visits to unroll are
 //    stored (smaller ones are cheaper to recompute than to keep); the table stops
 //    growing at `maxBytes`. Keys are 128-bit hashes of the instance.

@@ -1,0 +1,288 @@
+// The exact boxes of S-node instances (instance_boxes.h): every primitive of an instance
+// lies inside the instance's box, whatever the cache held; culling with them never
+// changes a hit; the table stays within its byte limit.
+#include "instance_boxes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "primitives.h"
+#include "test_support.h"
+#include "traversal.h"
+
+namespace pcsg::tracer {
+namespace {
+
+using testing::compile;
+
+// Systems whose instances differ a lot: parameter-dependent rotations and scales, CSG,
+// random heights (rand(x) and rand()), choose().
+const char* kTree = R"(
+{n = 7; a = 30} T
+T if(n > 0, 2, 1)
+1: T -> scale(0.1, 0.1, 1) cylinder
+2: T -> scale(0.1, 0.1, 1) cylinder ∪
+        {n = n-1; a = a + 7} move(0,0,1) rotz(137) (rotx(a) uscale(0.7) T ∪ roty(-a) uscale(0.6) T)
+)";
+
+const char* kTerrain = R"(
+{ cnt = 5; delta = 0.5; x1 = 0; y1 = 0; z1 = 0; z2 = 0.1; z3 = -0.1 } T
+T if(cnt > 0, 2, 1)
+1: T -> move(0,0,z1) zshear(z2-z1, z3-z1) tri1
+2: T -> {cnt = cnt-1; z2 = (z1+z2)/2 + (rand(x1*7+y1*3) - 0.5)*delta; delta = delta*0.5}
+          scale(0.5,0.5,1) T ∪
+        {cnt = cnt-1; x1 = x1 + 0.5; z3 = (z1+z3)/2 + (rand(x1*5+y1*11) - 0.5)*delta; delta = delta*0.5}
+          move(0.5,0,0) scale(0.5,0.5,1) T ∪
+        {cnt = cnt-1; y1 = y1 + 0.5; z1 = z1 + rand()*delta; delta = delta*0.5}
+          move(0,0.5,0) scale(0.5,0.5,1) T
+)";
+
+const char* kCsgPlant = R"(
+settings { seed 5 }
+{n = 5} P
+P if(n > 0, choose(0.6, 0.4) + 1, 1)
+1: P -> (sphere \ move(0.6,0,0) sphere) ∩ uscale(0.9) cube
+2: P -> cylinder ∪ {n = n-1} move(0,0,1) rotz(rand()*360) roty(25) uscale(0.8) P
+3: P -> torus(1, 0.2) ∪ {n = n-1} move(0,0,0.5) rotx(40) uscale(0.7) P ∪
+        {n = n-1} move(0,0,0.5) rotx(-40) uscale(0.6) P
+)";
+
+// Walks the expansion (recursively: small systems only) and, at every S-node instance,
+// asks `boxes` for its exact box; every primitive must lie inside the boxes of all the
+// S-node instances above it (each in its own frame). Returns the number of checks.
+class SoundnessWalk {
+  public:
+    SoundnessWalk(const Graph& g, const InstanceBoxes& boxes)
+        : g_(g), boxes_(boxes), worker_(boxes.makeWorker()) {}
+
+    size_t run() {
+        std::vector<double> frame(g_.slotCount());
+        initFrame(g_, frame.data());
+        walk(g_.axiom, frame, kRootPath, 0, Affine::identity(), 0);
+        return checks_;
+    }
+
+  private:
+    struct Open {
+        Box box;
+        Affine toWorld;  // the S-node's frame to the world
+    };
+
+    // `checkFrom`: the S-node instances open_[checkFrom..] must hold the primitives below;
+    // the ones above an intersection or difference need only hold what it keeps, so a
+    // primitive below may stick out of them.
+    void walk(NodeId n, const std::vector<double>& frame, uint64_t path, uint32_t depth,
+              const Affine& world, size_t checkFrom) {
+        const Node& node = g_.nodes[n];
+        const EvalState st{frame.data(), path};
+        switch (node.kind) {
+            case NodeKind::Select: {
+                ++depth;
+                open_.push_back({boxes_.box(*worker_, n, depth, frame.data(), path), world});
+                const uint32_t r = selectRule(g_, n, st);
+                walk(g_.child(n, r), frame, pathRule(path, r), depth, world, checkFrom);
+                open_.pop_back();
+                break;
+            }
+            case NodeKind::Calc: {
+                std::vector<double> next(g_.slotCount());
+                applyCalc(g_, n, st, next.data());
+                walk(g_.child(n), next, path, depth, world, checkFrom);
+                break;
+            }
+            case NodeKind::Transform:
+                walk(g_.child(n), frame, path, depth, world * transformMatrix(g_, n, st), checkFrom);
+                break;
+            case NodeKind::Paint: walk(g_.child(n), frame, path, depth, world, checkFrom); break;
+            case NodeKind::Union:
+            case NodeKind::Intersection:
+            case NodeKind::Difference:
+                for (uint32_t i = 0; i < node.childCount; ++i)
+                    walk(g_.child(n, i), frame, pathChild(path, i), depth, world,
+                         node.kind == NodeKind::Union ? checkFrom : open_.size());
+                break;
+            case NodeKind::Primitive: {
+                const Primitive& p = g_.primitives[node.payload];
+                if (p.kind == PrimitiveKind::Empty) break;
+                double args[9] = {};
+                if (storedArgs(p.kind)) primitiveArgs(g_, n, st, args);
+                Vec3 corners[3];
+                const bool triangle = isTriangle(p.kind);
+                if (triangle) triangleCorners(p.kind, args, corners);
+                const Box own = primitiveBox(p.kind, args);
+                for (size_t k = checkFrom; k < open_.size(); ++k) {
+                    const Open& o = open_[k];
+                    const Affine toS = o.toWorld.inverse() * world;
+                    auto check = [&](const Vec3& c) {
+                        if (!isFinite(c)) return;
+                        const Vec3 q = toS.point(c);
+                        ++checks_;
+                        EXPECT_TRUE(o.box.contains(q))
+                            << "a primitive at (" << q.x << ", " << q.y << ", " << q.z
+                            << ") outside its instance's box";
+                    };
+                    if (triangle) {
+                        for (const Vec3& c : corners) check(c);
+                    } else {
+                        for (int k = 0; k < 8; ++k)
+                            check(Vec3{k & 1 ? own.hi.x : own.lo.x, k & 2 ? own.hi.y : own.lo.y,
+                                       k & 4 ? own.hi.z : own.lo.z});
+                    }
+                }
+                break;
+            }
+        }
+    }
+
+    const Graph& g_;
+    const InstanceBoxes& boxes_;
+    InstanceBoxes::WorkerPtr worker_;
+    std::vector<Open> open_;
+    size_t checks_ = 0;
+};
+
+// Exact boxes at every depth, whatever the trial would decide.
+InstanceBoxOptions always() {
+    InstanceBoxOptions o;
+    o.trial = UINT32_MAX;
+    o.minWeight = 1;
+    return o;
+}
+
+TEST(InstanceBoxes, EveryPrimitiveLiesInsideTheBoxOfEachInstanceAboveIt) {
+    for (const char* text : {testing::kSierpinski, kTree, kTerrain, kCsgPlant}) {
+        auto c = compile(text);
+        ASSERT_TRUE(c->graph);
+        const Bounds bounds = computeBounds(*c->graph);
+        const InstanceBoxes boxes(*c->graph, bounds, always());
+        EXPECT_GT(SoundnessWalk(*c->graph, boxes).run(), 100u);
+        EXPECT_GT(boxes.stats().entries, 0u);
+    }
+}
+
+TEST(InstanceBoxes, TheBoxDoesNotDependOnWhatTheCacheHeld) {
+    for (const char* text : {kTree, kTerrain, kCsgPlant}) {
+        auto c = compile(text);
+        ASSERT_TRUE(c->graph);
+        const Graph& g = *c->graph;
+        const Bounds bounds = computeBounds(g);
+        InstanceBoxOptions none = always();
+        none.maxBytes = 0;  // nothing is ever stored
+        const InstanceBoxes cold(g, bounds, none), warm(g, bounds, always());
+        auto coldWorker = cold.makeWorker(), warmWorker = warm.makeWorker();
+        // The axiom's S-node instance, after its inner instances are in the warm cache.
+        std::vector<double> frame(g.slotCount());
+        initFrame(g, frame.data());
+        const NodeId calc = g.axiom, s = g.child(calc);
+        ASSERT_EQ(g.nodes[calc].kind, NodeKind::Calc);
+        ASSERT_EQ(g.nodes[s].kind, NodeKind::Select);
+        std::vector<double> f(g.slotCount());
+        applyCalc(g, calc, EvalState{frame.data(), kRootPath}, f.data());
+        const Box first = warm.box(*warmWorker, s, 1, f.data(), kRootPath);
+        const Box again = warm.box(*warmWorker, s, 1, f.data(), kRootPath);
+        const Box computed = cold.box(*coldWorker, s, 1, f.data(), kRootPath);
+        EXPECT_EQ(first, again);
+        EXPECT_EQ(first, computed);
+        EXPECT_EQ(cold.stats().entries, 0u);
+        EXPECT_GT(warm.stats().entries, 0u);
+        EXPECT_TRUE(first.isBounded());
+    }
+}
+
+TEST(InstanceBoxes, TheTableStaysWithinItsByteLimit) {
+    auto c = compile(kTerrain);
+    ASSERT_TRUE(c->graph);
+    const Bounds bounds = computeBounds(*c->graph);
+    InstanceBoxOptions small = always();
+    small.maxBytes = 16 * 1024;
+    const InstanceBoxes boxes(*c->graph, bounds, small);
+    EXPECT_GT(SoundnessWalk(*c->graph, boxes).run(), 100u);  // sound when full, too
+    const InstanceBoxStats st = boxes.stats();
+    EXPECT_LE(st.bytes, small.maxBytes);
+    EXPECT_TRUE(st.full);
+    EXPECT_GT(st.entries, 0u);
+}
+
+TEST(InstanceBoxes, TerrainInstancesAreMuchTighterThanTheStaticBoxes) {
+    // The reason they exist: a sub-triangle's static box spans all the terrain's heights.
+    // Go down the first operand of every union to the S-node instance at depth 4.
+    auto c = compile(kTerrain);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Bounds bounds = computeBounds(g);
+    const InstanceBoxes boxes(g, bounds, always());
+    auto w = boxes.makeWorker();
+    std::vector<double> frame(g.slotCount()), next(g.slotCount());
+    initFrame(g, frame.data());
+    uint64_t path = kRootPath;
+    uint32_t depth = 0;
+    for (NodeId n = g.axiom;;) {
+        const Node& node = g.nodes[n];
+        if (node.kind == NodeKind::Select) {
+            ++depth;
+            if (depth == 4) {
+                const Box exact = boxes.box(*w, n, depth, frame.data(), path);
+                const Box& fixed = bounds.select(g, n, depth);
+                EXPECT_LT(exact.hi.z - exact.lo.z, 0.5 * (fixed.hi.z - fixed.lo.z));
+                EXPECT_LE(exact.hi.x - exact.lo.x, fixed.hi.x - fixed.lo.x + 1e-6);
+                return;
+            }
+            const uint32_t r = selectRule(g, n, EvalState{frame.data(), path});
+            path = pathRule(path, r);
+            n = g.child(n, r);
+        } else if (node.kind == NodeKind::Calc) {
+            applyCalc(g, n, EvalState{frame.data(), path}, next.data());
+            frame.swap(next);
+            n = g.child(n);
+        } else if (node.kind == NodeKind::Union) {
+            path = pathChild(path, 0);
+            n = g.child(n, 0);
+        } else {
+            ASSERT_NE(node.kind, NodeKind::Primitive) << "the terrain ended above depth 4";
+            n = g.child(n);
+        }
+    }
+}
+
+// Random rays from around the object: the nearest hit (t, normal, material) is the same
+// bit for bit with static boxes, with exact instance boxes at every depth, and with no
+// culling at all.
+TEST(InstanceBoxes, CullingWithThemNeverChangesAHit) {
+    for (const char* text : {testing::kSierpinski, kTree, kTerrain, kCsgPlant}) {
+        auto c = compile(text);
+        ASSERT_TRUE(c->graph);
+        const Graph& g = *c->graph;
+        TraceScene none(g, computeBounds(g), false), fixed(g, computeBounds(g), false),
+            exact(g, computeBounds(g), true, always());
+        none.useBounds = false;
+        Tracer tn(none), tf(fixed), te(exact);
+        std::mt19937_64 rng(42);
+        std::uniform_real_distribution<double> u(-1, 1);
+        int hits = 0;
+        for (int i = 0; i < 3000; ++i) {
+            const Vec3 o{u(rng) * 4, u(rng) * 4, u(rng) * 4 + 1};
+            const Vec3 target{u(rng) * 1.5, u(rng) * 1.5, u(rng) * 2 + 0.5};
+            const Vec3 d = normalize(target - o);
+            SurfaceHit a, b, e;
+            const bool ha = tn.firstHit(o, d, 1e-4, 1e7, a);
+            const bool hb = tf.firstHit(o, d, 1e-4, 1e7, b);
+            const bool he = te.firstHit(o, d, 1e-4, 1e7, e);
+            ASSERT_EQ(ha, hb) << "ray " << i;
+            ASSERT_EQ(ha, he) << "ray " << i;
+            EXPECT_EQ(te.anyHit(o, d, 1e-4, 1e7), ha) << "ray " << i;
+            if (!ha) continue;
+            ++hits;
+            EXPECT_EQ(a.t, e.t) << "ray " << i;
+            EXPECT_EQ(a.normal, e.normal) << "ray " << i;
+            EXPECT_EQ(a.material, e.material) << "ray " << i;
+            EXPECT_EQ(a.t, b.t) << "ray " << i;
+        }
+        EXPECT_GT(hits, 50);
+        EXPECT_LT(te.nodeVisits(), tn.nodeVisits());
+    }
+}
+
+}  // namespace
+}  // namespace pcsg::tracer
