@@ -1,11 +1,15 @@
 // Helpers for tests that run the built `pcsg` executable (PCSG_EXECUTABLE) on small
-// scene files written into a temporary directory.
+// scene files written into a temporary directory, and the `pcsg-image` helper
+// (PCSG_IMAGE_EXECUTABLE).
 #pragma once
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -71,6 +75,22 @@ inline std::string readFile(const std::string& path) {
 inline ChildResult pcsg(std::vector<std::string> args) {
     args.insert(args.begin(), PCSG_EXECUTABLE);
     return runChild(args);
+}
+
+// Runs `pcsg-image args...` with `input` on its standard input.
+inline ChildResult pcsgImage(std::vector<std::string> args, std::span<const std::byte> input) {
+    args.insert(args.begin(), PCSG_IMAGE_EXECUTABLE);
+    return runChild(args, input);
+}
+
+// The names of the files in a directory, sorted (to see that nothing was left behind).
+inline std::vector<std::string> filesIn(const std::string& dir) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec))
+        names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
 }
 
 }  // namespace pcsg::tools::testing

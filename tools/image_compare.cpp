@@ -6,16 +6,16 @@
 
 #include <OpenImageIO/imagebufalgo.h>
 
+#include "image_format.h"
+
 namespace pcsg::tools {
 
 namespace {
-// The sRGB transfer function (IEC 61966-2-1).
 float linearToSrgb(float v) {
-    v = std::clamp(v, 0.0f, 1.0f);
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    return static_cast<float>(srgbEncode(v));
 }
 float srgbToLinear(float v) {
-    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+    return static_cast<float>(srgbDecode(v));
 }
 }  // namespace
 

@@ -3,9 +3,15 @@
 // Ray traces the scene's cyclic graph directly (tracer/): the graph is never expanded.
 // Prints the figures of the paper's Table 1 and more (tools/stats.h).
 //
+// The image file is written by the pcsg-image helper (tools/image_helper.h): this process
+// renders, then pipes its linear float pixels to `pcsg-image write`, so that it never
+// loads OpenImageIO. Its peak RSS is its own (getrusage RUSAGE_SELF); the writer's is
+// printed beside it.
+//
 // Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
 // run-time error of LANGUAGE.md, reported once with its module path; no image is
-// written); 2 something could not run (bad options, an unwritable output file).
+// written); 2 something could not run (bad options, an unwritable output file, no
+// pcsg-image).
 #include <unistd.h>
 
 #include <atomic>
@@ -22,6 +28,8 @@
 #include "commands.h"
 #include "eval.h"
 #include "expander.h"
+#include "image_format.h"
+#include "image_helper.h"
 #include "render.h"
 #include "scene_input.h"
 #include "stats.h"
@@ -69,12 +77,6 @@ private:
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-bool knownImageType(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext == ".png" || ext == ".exr" || ext == ".tif" || ext == ".tiff";
-}
-
 int runRender(const RenderCommandOptions& o) {
     if (o.width <= 0 || o.height <= 0) {
         std::cerr << "pcsg render: --width and --height must be positive\n";
@@ -97,11 +99,16 @@ int runRender(const RenderCommandOptions& o) {
         std::cerr << "pcsg render: --threads must not be negative (0: all cores)\n";
         return 2;
     }
-    if (!knownImageType(o.output)) {
-        std::cerr << fmt::format(
-            "pcsg render: cannot write '{}': unknown image type (use .png for 8-bit sRGB, "
-            ".exr for linear float, .tif or .tiff for 16-bit sRGB)\n",
-            o.output);
+    if (!imageFormatOf(o.output)) {
+        std::cerr << fmt::format("pcsg render: cannot write '{}': unknown image type ({})\n",
+                                 o.output, kImageTypesHint);
+        return 2;
+    }
+    // Before the render: without the writer, the render would be for nothing.
+    const std::optional<std::string> imageHelper = findImageHelper();
+    if (!imageHelper) {
+        std::cerr << "pcsg render: cannot write '" << o.output
+                  << "': " << missingImageHelperMessage() << "\n";
         return 2;
     }
     const CompiledScene compiled = compileScene(o.scene, std::cerr);
@@ -154,16 +161,17 @@ int runRender(const RenderCommandOptions& o) {
     }
     if (showProgress) bar->finish();
 
-    try {
-        tracer::writeImage(o.output, o.width, o.height, result.rgb);
-    } catch (const std::exception& e) {
-        std::cerr << "pcsg render: " << e.what() << "\n";
+    const ImageWriteResult written =
+        writeImageWithHelper(*imageHelper, o.output, o.width, o.height, result.rgb);
+    if (!written.ok) {
+        std::cerr << "pcsg render: " << written.error << "\n";
         return 2;
     }
 
     s.rays = result.rays;
     s.seconds = result.seconds;
     s.raysPerSecond = result.seconds > 0 ? result.rays / result.seconds : 0.0;
+    // RUSAGE_SELF: this process's own peak, without the writer's (printed beside it).
     s.peakRssBytes = peakRssBytes();
     if (o.json) {
         nlohmann::json j = s.toJson();
@@ -174,6 +182,8 @@ int runRender(const RenderCommandOptions& o) {
         j["aa"] = o.aa;
         j["adaptive"] = o.adaptive;
         j["graph_nodes"] = g.nodes.size();
+        j["image_writer_peak_rss_bytes"] = written.peakRssBytes;
+        j["image_write_seconds"] = written.seconds;
         if (!count.complete) j["primitive_equivalence_note"] = "too large to count (rand/choose)";
         std::cout << j.dump(2) << "\n";
     } else {
@@ -185,6 +195,9 @@ int runRender(const RenderCommandOptions& o) {
                                      "too large to count (the system uses rand() or choose())");
         std::cout << fmt::format("{:<24}{}\n", "graph nodes", g.nodes.size());
         std::cout << fmt::format("{:<24}{}\n", "node visits", result.nodeVisits);
+        std::cout << fmt::format("{:<24}{} ({}, {:.3f} s)\n", "image writer peak RSS",
+                                 humanBytes(written.peakRssBytes), kImageHelperName,
+                                 written.seconds);
     }
     return 0;
 }
@@ -199,7 +212,9 @@ void addRenderCommand(CLI::App& app, int& status) {
         "image (.png 8-bit sRGB, .exr linear float, .tif 16-bit sRGB). Camera, lights and "
         "materials follow POV-Ray 3.7, so the image can be compared with POV-Ray's rendering "
         "of `pcsg export-pov`. Prints rays, rays per second, primitive equivalence (the "
-        "primitives the expanded tree would hold), graph bytes, peak memory and time.\n"
+        "primitives the expanded tree would hold), graph bytes, peak memory and time. The "
+        "image file is written by the pcsg-image helper (found beside pcsg, or in PATH), which "
+        "gets the pixels through a pipe; its peak memory is printed separately.\n"
         "Exit status: 0 written, 1 the scene has an error (nothing written), 2 could not run.");
     cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input)")->required();
     cmd->add_option("-o,--output", o->output, "The image to write: .png, .exr, .tif or .tiff")

@@ -5,7 +5,10 @@
 // Both renders run as child processes of this one, so that each one's peak RSS is its
 // own (wait4's rusage), and both run without anti-aliasing at K times the size; the two
 // images are then reduced by the same K×K box filter, so edge sampling is identical.
+// Reading, reducing and comparing the images is `pcsg-image compare`'s job (a process of
+// its own, the only one that loads OpenImageIO: tools/image_helper.h).
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -14,9 +17,9 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.h"
-#include "renders.h"
 #include "commands.h"
-#include "image_compare.h"
+#include "image_helper.h"
+#include "renders.h"
 #include "stats.h"
 
 namespace pcsg::tools {
@@ -35,12 +38,14 @@ struct VerifyOptions {
     bool json = false;
     bool keep = false;
     Thresholds thresholds;
+    std::string imageHelper;  // pcsg-image
 };
 
 struct Side {
     double seconds = 0;          // wall time of the render process
     uint64_t peakRssBytes = 0;   // of the render process
     std::optional<double> parseSeconds;
+    std::optional<uint64_t> imageWriterPeakRssBytes;  // native: pcsg-image write's
 };
 
 struct SceneResult {
@@ -75,7 +80,12 @@ SceneResult verifyScene(const std::string& scene, const VerifyOptions& o, const 
         return r;
     }
     r.native.seconds = native.child.seconds;
-    r.native.peakRssBytes = native.child.peakRssBytes;
+    // The render process's own peak (wait4 would report the larger of it and that of the
+    // pcsg-image it ran to write the image); the writer's is kept beside it.
+    r.native.peakRssBytes =
+        jsonField<uint64_t>(native.json, "peak_rss_bytes").value_or(native.child.peakRssBytes);
+    r.native.imageWriterPeakRssBytes =
+        jsonField<uint64_t>(native.json, "image_writer_peak_rss_bytes");
     r.raysPerSecond = jsonField<double>(native.json, "rays_per_second");
     r.graphBytes = jsonField<uint64_t>(native.json, "graph_bytes");
 
@@ -114,26 +124,27 @@ SceneResult verifyScene(const std::string& scene, const VerifyOptions& o, const 
     r.povray.peakRssBytes = povray.child.peakRssBytes;
     r.povray.parseSeconds = povray.parseSeconds;
 
-    // 4. The same box filter on both, then the comparison.
-    OIIO::ImageBuf a, b;
-    std::string error;
-    if (!readLinear(nativeFull.string(), a, error) || !readLinear(povFull.string(), b, error)) {
-        r.message = error;
-        return r;
-    }
-    if (a.spec().width != W || a.spec().height != H || b.spec().width != W || b.spec().height != H) {
+    // 4. The same box filter on both, then the comparison (pcsg-image compare), which also
+    // writes the reduced images and the heat map for the report.
+    ImageCompareOptions co;
+    co.ss = o.ss;
+    co.thresholds = o.thresholds;
+    co.reducedA = (work / "native.png").string();
+    co.reducedB = (work / "povray.png").string();
+    co.heatMap = (work / "diff.png").string();
+    const ImageCompareRun cmp =
+        compareImagesWithHelper(o.imageHelper, nativeFull.string(), povFull.string(), co);
+    if (cmp.widthA > 0 && cmp.widthB > 0 &&
+        (cmp.widthA != W || cmp.heightA != H || cmp.widthB != W || cmp.heightB != H)) {
         r.message = fmt::format("image sizes differ: native {}x{}, POV-Ray {}x{}, expected {}x{}",
-                                a.spec().width, a.spec().height, b.spec().width, b.spec().height, W, H);
+                                cmp.widthA, cmp.heightA, cmp.widthB, cmp.heightB, W, H);
         return r;
     }
-    const OIIO::ImageBuf na = boxReduce(a, o.ss), nb = boxReduce(b, o.ss);
-    r.metrics = compareImages(na, nb, o.thresholds);
-    if (!writeSrgbPng(na, (work / "native.png").string(), error) ||
-        !writeSrgbPng(nb, (work / "povray.png").string(), error) ||
-        !writeSrgbPng(diffHeatMap(na, nb), (work / "diff.png").string(), error)) {
-        r.message = error;
+    if (cmp.status == 2) {
+        r.message = "comparing the images failed:\n" + firstLines(cmp.error);
         return r;
     }
+    r.metrics = *cmp.metrics;
     fs::remove(nativeFull, ec);
     fs::remove(povFull, ec);
     r.status = r.metrics.agree ? 0 : 1;
@@ -188,6 +199,8 @@ nlohmann::json toJson(const SceneResult& r) {
         j["share_off"] = m.shareOff;
         j["native_seconds"] = r.native.seconds;
         j["native_peak_rss_bytes"] = r.native.peakRssBytes;
+        if (r.native.imageWriterPeakRssBytes)
+            j["native_image_writer_peak_rss_bytes"] = *r.native.imageWriterPeakRssBytes;
         j["povray_seconds"] = r.povray.seconds;
         j["povray_peak_rss_bytes"] = r.povray.peakRssBytes;
         if (r.povray.parseSeconds) j["povray_parse_seconds"] = *r.povray.parseSeconds;
@@ -313,6 +326,12 @@ int runVerify(VerifyOptions o) {
                      "install it with `apt-get install povray`\n";
         return 2;
     }
+    if (const auto helper = findImageHelper()) {
+        o.imageHelper = *helper;
+    } else {
+        std::cerr << "pcsg verify: " << missingImageHelperMessage() << "\n";
+        return 2;
+    }
     fs::path root;
     bool temporary = false;
     if (!o.reportDir.empty()) {
@@ -362,10 +381,14 @@ void addVerifyCommand(CLI::App& app, int& status) {
     auto o = std::make_shared<VerifyOptions>();
     auto* cmd = app.add_subcommand(
         "verify",
-        "Render a scene natively (the cyclic graph) and with POV-Ray (the expanded tree written by\n"
-        "export-pov), both without anti-aliasing at --ss times the size, reduce both with the same\n"
-        "box filter, and compare them. Exit status: 0 the images agree, 1 they differ, 2 something\n"
-        "could not run. Also reports memory (graph vs expanded tree, both peak RSS) and time.");
+        "Render a scene natively (the cyclic graph) and with POV-Ray (the expanded tree written "
+        "by\n"
+        "export-pov), both without anti-aliasing at --ss times the size, reduce both with the "
+        "same\n"
+        "box filter, and compare them. Exit status: 0 the images agree, 1 they differ, 2 "
+        "something\n"
+        "could not run. Also reports memory (graph vs expanded tree, both peak RSS) and time.\n"
+        "The images are compared by the pcsg-image helper (beside pcsg, or in PATH).");
     cmd->add_option("scenes", o->scenes, "Scene files (.pcsg)");
     cmd->add_option("--all", o->allDir, "Verify every .pcsg file in this directory");
     cmd->add_option("--width", o->width, "Image width after reduction")->capture_default_str();

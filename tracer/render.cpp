@@ -1,6 +1,5 @@
 #include "render.h"
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <pthread.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -12,7 +11,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -78,12 +76,6 @@ struct Worker {
 };
 
 }  // namespace
-
-double srgbEncode(double x) {
-    if (!(x > 0)) return 0;
-    if (x >= 1) return 1;
-    return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
-}
 
 RenderResult render(const Graph& g, const RenderOptions& opt) {
     using Clock = std::chrono::steady_clock;
@@ -207,66 +199,6 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
     if (firstError) std::rethrow_exception(firstError);
     result.seconds = std::chrono::duration<double>(Clock::now() - t1).count();
     return result;
-}
-void writeImage(const std::string& path, int width, int height, const std::vector<float>& rgb) {
-    namespace fs = std::filesystem;
-    const fs::path target(path);
-    std::string ext = target.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    OIIO::TypeDesc type;
-    bool linear = false;
-    if (ext == ".png") {
-        type = OIIO::TypeDesc::UINT8;
-    } else if (ext == ".tif" || ext == ".tiff") {
-        type = OIIO::TypeDesc::UINT16;
-    } else if (ext == ".exr") {
-        type = OIIO::TypeDesc::FLOAT;
-        linear = true;
-    } else {
-        throw std::runtime_error(fmt::format(
-            "cannot write '{}': unknown image type '{}' (use .png, .tif, .tiff or .exr)", path,
-            ext));
-    }
-    const size_t n = static_cast<size_t>(width) * height * 3;
-    std::vector<uint8_t> bytes8;
-    std::vector<uint16_t> bytes16;
-    const void* data = rgb.data();
-    if (type == OIIO::TypeDesc::UINT8) {
-        bytes8.resize(n);
-        for (size_t i = 0; i < n; ++i)
-            bytes8[i] = static_cast<uint8_t>(std::lround(srgbEncode(rgb[i]) * 255.0));
-        data = bytes8.data();
-    } else if (type == OIIO::TypeDesc::UINT16) {
-        bytes16.resize(n);
-        for (size_t i = 0; i < n; ++i)
-            bytes16[i] = static_cast<uint16_t>(std::lround(srgbEncode(rgb[i]) * 65535.0));
-        data = bytes16.data();
-    }
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    const fs::path tmp = dir / fmt::format(".{}.tmp{}{}", target.stem().string(), getpid(), ext);
-    auto out = OIIO::ImageOutput::create(tmp.string());
-    if (!out)
-        throw std::runtime_error(fmt::format("cannot write '{}': {}", path, OIIO::geterror()));
-    OIIO::ImageSpec spec(width, height, 3, type);
-    spec.attribute("oiio:ColorSpace", linear ? "Linear" : "sRGB");
-    spec.attribute("Software", "pcsg");
-    if (!out->open(tmp.string(), spec))
-        throw std::runtime_error(fmt::format("cannot write '{}': {}", path, out->geterror()));
-    const bool ok = out->write_image(type, data);
-    const std::string err = ok ? std::string() : out->geterror();
-    out->close();
-    if (!ok) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
-        throw std::runtime_error(fmt::format("cannot write '{}': {}", path, err));
-    }
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw std::runtime_error(fmt::format("cannot write '{}': {}", path, ec.message()));
-    }
 }
 
 }  // namespace pcsg::tracer

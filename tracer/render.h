@@ -1,5 +1,5 @@
-// Rendering an image: pixels in tiles, in parallel with oneTBB, anti-aliasing, and the
-// image file through OpenImageIO.
+// Rendering an image: pixels in tiles, in parallel with oneTBB, anti-aliasing. The result
+// is linear float RGB; image files are written by the pcsg-image helper (tools/image_io.h).
 //
 //  - Every pixel's colour depends only on the pixel (fixed sample positions, no shared
 //    mutable state), so the image is the same byte for byte whatever the thread count.
@@ -53,13 +53,5 @@ struct RenderResult {
 // Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)
 // or std::runtime_error (the stack cannot be made large enough).
 RenderResult render(const Graph& g, const RenderOptions& options);
-
-// Writes an image by the file name's extension: .png (8-bit sRGB), .tif/.tiff (16-bit
-// sRGB), .exr (linear 32-bit float). Writes to a temporary file beside the target and
-// renames it, so a failed write never leaves a partial image. Throws std::runtime_error.
-void writeImage(const std::string& path, int width, int height, const std::vector<float>& rgb);
-
-// The sRGB encoding of a linear value, clamped to [0, 1].
-double srgbEncode(double linear);
 
 }  // namespace pcsg::tracer
