@@ -58,6 +58,7 @@ install_missing() {
 install_missing
 cmake --preset release
 if [[ $mode == run ]]; then
+    # Builds pcsg-image too: pcsg depends on the helper that writes and compares images.
     cmake --build "$BUILD" --target pcsg
     main_job
 else
