@@ -48,6 +48,8 @@ struct RenderCommandOptions {
     int threads = 0;
     bool json = false;
     bool noBounds = false;
+    bool noInstanceBoxes = false;
+    size_t boxCacheMb = 64;
     uint64_t countVisits = 20'000'000;
 };
 
@@ -143,6 +145,8 @@ int runRender(const RenderCommandOptions& o) {
     ro.adaptive = o.adaptive;
     ro.threads = o.threads;
     ro.useBounds = !o.noBounds;
+    ro.instanceBoxes = !o.noInstanceBoxes;
+    ro.instanceBoxBytes = o.boxCacheMb << 20;
     auto bar = std::make_shared<ProgressBar>();
     const bool showProgress = isatty(STDERR_FILENO) != 0;
     if (showProgress) ro.progress = [bar](double f) { bar->update(f); };
@@ -179,6 +183,10 @@ int runRender(const RenderCommandOptions& o) {
         j["node_visits"] = result.nodeVisits;
         j["bounds_seconds"] = result.boundsSeconds;
         j["unbounded_nodes"] = result.infiniteBoxes;
+        j["instance_boxes"] = {{"entries", result.instanceBoxes.entries},
+                               {"bytes", result.instanceBoxes.bytes},
+                               {"computed", result.instanceBoxes.computed},
+                               {"full", result.instanceBoxes.full}};
         j["aa"] = o.aa;
         j["adaptive"] = o.adaptive;
         j["graph_nodes"] = g.nodes.size();
@@ -195,6 +203,11 @@ int runRender(const RenderCommandOptions& o) {
                                      "too large to count (the system uses rand() or choose())");
         std::cout << fmt::format("{:<24}{}\n", "graph nodes", g.nodes.size());
         std::cout << fmt::format("{:<24}{}\n", "node visits", result.nodeVisits);
+        if (result.instanceBoxes.entries > 0)
+            std::cout << fmt::format("{:<24}{} instances, {}{}\n", "instance-box cache",
+                                     result.instanceBoxes.entries,
+                                     humanBytes(result.instanceBoxes.bytes),
+                                     result.instanceBoxes.full ? " (full)" : "");
         std::cout << fmt::format("{:<24}{} ({}, {:.3f} s)\n", "image writer peak RSS",
                                  humanBytes(written.peakRssBytes), kImageHelperName,
                                  written.seconds);
@@ -235,6 +248,14 @@ void addRenderCommand(CLI::App& app, int& status) {
     cmd->add_flag("--no-bounds", o->noBounds,
                   "Do not cull with hyper-bounding boxes (slow; for checking that culling never "
                   "changes the image)");
+    cmd->add_flag("--no-instance-boxes", o->noInstanceBoxes,
+                  "Cull with the static hyper-bounding boxes alone, without the exact boxes of "
+                  "sub-graph instances (for comparison; the image is the same)");
+    cmd->add_option("--box-cache-mb", o->boxCacheMb,
+                    "Memory limit of the instance-box cache in MB (the exact boxes of sub-graph "
+                    "instances, filled lazily while rendering)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--count-visits", o->countVisits,
                     "Work limit of the primitive-equivalence count in graph-node visits")
         ->capture_default_str();

@@ -89,7 +89,9 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
     result.infiniteBoxes = bounds.infiniteNodes;
     const auto t1 = Clock::now();
     result.boundsSeconds = std::chrono::duration<double>(t1 - t0).count();
-    TraceScene scene(g, std::move(bounds));
+    InstanceBoxOptions boxOptions;
+    boxOptions.maxBytes = opt.instanceBoxBytes;
+    TraceScene scene(g, std::move(bounds), opt.instanceBoxes, boxOptions);
     scene.useBounds = opt.useBounds;
     const PinholeCamera camera(g.scene.camera, opt.width, opt.height);
     const size_t stack = scene.stackBytesNeeded();
@@ -197,6 +199,7 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
     };
     runWithStack(stack, work);
     if (firstError) std::rethrow_exception(firstError);
+    if (scene.instanceBoxes()) result.instanceBoxes = scene.instanceBoxes()->stats();
     result.seconds = std::chrono::duration<double>(Clock::now() - t1).count();
     return result;
 }

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "graph.h"
+#include "instance_boxes.h"
 
 namespace pcsg::tracer {
 
@@ -36,6 +37,10 @@ struct RenderOptions {
     int adaptiveDepth = 3;  // POV-Ray's +R
     int threads = 0;        // 0: all cores
     bool useBounds = true;  // tests compare against rendering without culling
+    // Exact boxes of S-node instances where the static ones are loose (instance_boxes.h),
+    // kept in a table of at most this many bytes.
+    bool instanceBoxes = true;
+    size_t instanceBoxBytes = 64u << 20;
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
 };
@@ -48,6 +53,7 @@ struct RenderResult {
     double seconds = 0;          // the render proper
     double boundsSeconds = 0;    // computing the hyper-bounding boxes
     uint32_t infiniteBoxes = 0;  // nodes left with unbounded boxes
+    InstanceBoxStats instanceBoxes;  // the instance-box cache at the end
 };
 
 // Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)
