@@ -820,13 +820,9 @@ private:
         std::vector<double> values;
         const bool constant = arguments(n, tr.firstArg, values);
         if (constant) {
-            const Affine m = makeTransform(n.op, values.data());
-            const bool zeroAxis = n.op == TransformOp::Rot && values[0] == 0 && values[1] == 0 && values[2] == 0;
-            // A singular or non-finite constant transformation stays unfolded, so that the
-            // shared run-time check reports it where it is used (LANGUAGE.md section 5).
-            if (!zeroAxis && m.isFinite() && m.determinant() != 0) {
+            if (const std::optional<Affine> m = constantTransform(n.op, values.data())) {
                 tr.constant = true;
-                tr.matrix = m;
+                tr.matrix = *m;
             }
         }
         g_.transforms.push_back(tr);

@@ -9,13 +9,14 @@
 #include <fmt/format.h>
 
 #include "builder.h"
+#include "fold_constants.h"
 #include "lexer.h"
 #include "parser.h"
 
 namespace pcsg {
 
 std::optional<Graph> compileSource(std::string_view fileName, std::string_view text,
-                                   Diagnostics& diags) {
+                                   Diagnostics& diags, const CompileOptions& options) {
     const size_t errorsBefore = diags.errors().size();
     const uint32_t file = diags.addFile(std::string(fileName), text);
     if (text.size() > kMaxSourceBytes) {
@@ -38,6 +39,7 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
     // so that one run reports as many independent errors as it can.
     std::optional<Graph> g = build(src, tokens, ast, diags);
     if (diags.errors().size() != errorsBefore) return std::nullopt;
+    if (g && options.foldConstants) foldConstantParameters(*g);
     return g;
 }
 

@@ -1,6 +1,7 @@
 // The compiler's entry points: from .pcsg text to the cyclic CSG graph.
 // Phases: lexer.cpp (tokens, #define expansion) -> parser.cpp (AST, ast.h) ->
-// builder.cpp (name and arity checks, the Graph of graph.h).
+// builder.cpp (name and arity checks, the Graph of graph.h) -> fold_constants.cpp
+// (parameters that are constants become constants).
 #pragma once
 
 #include <optional>
@@ -12,10 +13,16 @@
 
 namespace pcsg {
 
+struct CompileOptions {
+    // Fold parameters that are constants (fold_constants.h). Off only for tests that
+    // check the folding changes nothing.
+    bool foldConstants = true;
+};
+
 // Compiles source text. Returns the graph, or nothing with the errors in `diags`.
 // `text` must outlive `diags` (diagnostics quote source lines).
 std::optional<Graph> compileSource(std::string_view fileName, std::string_view text,
-                                   Diagnostics& diags);
+                                   Diagnostics& diags, const CompileOptions& options = {});
 
 // Reads and compiles a file. An unreadable file is a diagnostic too. The file's text is
 // kept alive by `diags`' owner through `storage`.

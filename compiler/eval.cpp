@@ -350,6 +350,13 @@ Affine makeTransform(TransformOp op, const double* a) {
     return m;
 }
 
+std::optional<Affine> constantTransform(TransformOp op, const double* a) {
+    if (op == TransformOp::Rot && a[0] == 0 && a[1] == 0 && a[2] == 0) return std::nullopt;
+    const Affine m = makeTransform(op, a);
+    if (!m.isFinite() || !(m.determinant() != 0)) return std::nullopt;
+    return m;
+}
+
 Affine transformMatrix(const Graph& g, NodeId n, EvalState s) {
     const Transform& t = g.transforms[g.nodes[n].payload];
     if (t.constant) return t.matrix;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -83,6 +84,12 @@ Affine transformMatrix(const Graph& g, NodeId transformNode, EvalState s);
 // The matrix of one transformation from its evaluated arguments (shared with tests and
 // the builder's constant folding). `args` has the count the operation takes.
 Affine makeTransform(TransformOp op, const double* args);
+
+// The precomputed matrix of a T-node whose arguments are the constants `args`, or nothing
+// when they make a singular or non-finite transformation (rot about the zero axis, a zero
+// scale factor): such a T-node stays unfolded, so that the run-time check reports it
+// where it is used (LANGUAGE.md section 5).
+std::optional<Affine> constantTransform(TransformOp op, const double* args);
 
 // A primitive's argument values (torus radii, triangle corners) for the given state.
 // Throws RuntimeError on non-finite values.
