@@ -10,7 +10,7 @@
 #include <deque>
 #include <limits>
 
-#include "span_list.h"
+#include "operators.h"
 
 namespace pcsg::tracer {
 
@@ -45,24 +45,6 @@ uintptr_t threadStackLimit() {
         return ok ? reinterpret_cast<uintptr_t>(addr) + kStackMargin : uintptr_t(0);
     }();
     return limit;
-}
-
-// Clips [t0, t1] to the part of the line inside the box; false when nothing is left.
-inline bool clipToBox(const Box& b, const Vec3& o, const Vec3& d, double& t0, double& t1) {
-    if (b.lo.x > b.hi.x) return false;  // empty
-    for (int i = 0; i < 3; ++i) {
-        if (d[i] == 0) {
-            if (o[i] < b.lo[i] || o[i] > b.hi[i]) return false;
-            continue;
-        }
-        const double inv = 1.0 / d[i];
-        double a = (b.lo[i] - o[i]) * inv, c = (b.hi[i] - o[i]) * inv;
-        if (a > c) std::swap(a, c);
-        if (a > t0) t0 = a;
-        if (c < t1) t1 = c;
-        if (!(t0 <= t1)) return false;
-    }
-    return true;
 }
 
 }  // namespace
@@ -156,7 +138,7 @@ Tracer::Tracer(const TraceScene& scene)
 
 // Whether the ray misses the S-node n (at `depth`) within [tmin, tmax]: its box at that
 // depth, then, where it pays, the exact box of this instance.
-bool Tracer::selectCulled(NodeId n, const LRay& r, const Ctx& c, uint32_t depth, double tmin,
+bool Tracer::selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
                           double tmax) {
     if (!scene_.useBounds) return false;
     double t0 = tmin, t1 = tmax;
@@ -183,12 +165,12 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     order_.clear();
     if (g_.axiom == kNone) return false;
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0};
-    const LRay r{origin, dir};
+    const LocalRay r{origin, dir};
     if (scene_.useBounds) {
         double t0 = tmin, t1 = tmax;
         if (!clipToBox(scene_.bounds_.node[g_.axiom], origin, dir, t0, t1)) return false;
     }
-    LocalHit hit;
+    Hit hit;
     double best = tmax;
     if (!first(g_.axiom, r, c, tmin, best, hit)) return false;
     out.t = hit.t;
@@ -209,34 +191,8 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
     return walk(origin, dir, tmin, tmax, hit);
 }
 
-// A surface at t from the instance `key` replaces the nearest one so far (at tmax)?
-// Nearer wins; at the same distance, the smaller instance path.
-static inline bool nearer(double t, uint64_t key, double tmax, const auto& hit) {
-    return t < tmax || (t == tmax && hit.valid && key < hit.key);
-}
-
-// The first boundary of the span list at spans_[base, base + count) with tmin < t < tmax
-// (or at tmax, winning the tie): becomes `hit`.
-bool Tracer::boundaryHit(size_t base, size_t count, double tmin, double tmax, uint64_t key,
-                         LocalHit& hit) {
-    for (size_t k = 0; k < count; ++k) {
-        const Span& s = spans_[base + k];
-        const Boundary* b = nullptr;
-        if (s.in.t > tmin)
-            b = &s.in;
-        else if (s.out.t > tmin)
-            b = &s.out;
-        else
-            continue;
-        if (!nearer(b->t, key, tmax, hit)) return false;
-        hit = LocalHit{b->t, b->normal, b->material, true, key};
-        return true;
-    }
-    return false;
-}
-
-bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& tmax,
-                   LocalHit& hit) {
+bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
+                   Hit& hit) {
     ++visits_;
     const Node& node = g_.nodes[n];
     switch (node.kind) {
@@ -272,7 +228,7 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
                 inv = &computed;
                 target = g_.child(n);
             }
-            const LRay rr{inv->point(r.o), inv->vector(r.d)};
+            const LocalRay rr{inv->point(r.o), inv->vector(r.d)};
             if (!first(target, rr, c, tmin, tmax, hit)) return false;
             hit.normal = inv->transposedVector(hit.normal);
             return true;
@@ -280,36 +236,23 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
         case NodeKind::Paint:
             return first(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload}, tmin, tmax,
                          hit);
-        case NodeKind::Union: {
-            // Front to back by box entry; stop when the next box starts beyond the best hit.
-            const size_t base = order_.size();
-            for (uint32_t i = 0; i < node.childCount; ++i) {
-                double t0 = tmin, t1 = tmax;
-                if (scene_.useBounds &&
-                    !clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, t0, t1))
-                    continue;
-                order_.emplace_back(t0, i);
-            }
-            const size_t end = order_.size();
-            if (end - base > 1) std::sort(order_.begin() + base, order_.begin() + end);
-            bool found = false;
-            for (size_t k = base; k < end; ++k) {
-                const auto [entry, i] = order_[k];
-                if (entry > tmax) break;  // (at tmax exactly it may still win a tie)
-                const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
-                if (first(g_.child(n, i), r, cc, tmin, tmax, hit)) {
-                    found = true;
-                    if (anyHit_) break;
-                }
-            }
-            order_.resize(base);
-            return found;
-        }
+        case NodeKind::Union:
+            return firstOfUnion(
+                node.childCount, tmin, tmax, hit, anyHit_, order_,
+                [&](uint32_t i, double& t0) {
+                    double t1 = tmax;
+                    return !scene_.useBounds ||
+                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, t0, t1);
+                },
+                [&](uint32_t i, double& best, Hit& h) {
+                    const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
+                    return first(g_.child(n, i), r, cc, tmin, best, h);
+                });
         case NodeKind::Intersection:
         case NodeKind::Difference: {
             const size_t base = spans_.size();
             const size_t count = spans(n, r, c, tmin, tmax);
-            const bool found = boundaryHit(base, count, tmin, tmax, c.path, hit);
+            const bool found = boundaryHit(spans_, base, count, tmin, tmax, c.path, hit);
             spans_.resize(base);
             if (found) tmax = hit.t;
             return found;
@@ -328,7 +271,7 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
                                        std::nextafter(tmax, kInfinity), b) ||
                     !nearer(b.t, c.path, tmax, hit))
                     return false;
-                hit = LocalHit{b.t, b.normal, c.material, true, c.path};
+                hit = Hit{b.t, b.normal, c.material, true, c.path};
                 tmax = b.t;
                 return true;
             }
@@ -339,7 +282,7 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
                     s[k].in.t > tmin ? &s[k].in : (s[k].out.t > tmin ? &s[k].out : nullptr);
                 if (!b) continue;
                 if (!nearer(b->t, c.path, tmax, hit)) return false;
-                hit = LocalHit{b->t, b->normal, c.material, true, c.path};
+                hit = Hit{b->t, b->normal, c.material, true, c.path};
                 tmax = b->t;
                 return true;
             }
@@ -349,7 +292,7 @@ bool Tracer::first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& t
     return false;
 }
 
-size_t Tracer::spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double tmax) {
+size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax) {
     ++visits_;
     const Node& node = g_.nodes[n];
     switch (node.kind) {
@@ -385,7 +328,7 @@ size_t Tracer::spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double 
                 inv = &computed;
                 target = g_.child(n);
             }
-            const LRay rr{inv->point(r.o), inv->vector(r.d)};
+            const LocalRay rr{inv->point(r.o), inv->vector(r.d)};
             const size_t base = spans_.size();
             const size_t count = spans(target, rr, c, tmin, tmax);
             for (size_t k = base; k < base + count; ++k) {
@@ -398,69 +341,17 @@ size_t Tracer::spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double 
             return spans(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload}, tmin, tmax);
         case NodeKind::Union:
         case NodeKind::Intersection:
-        case NodeKind::Difference: {
-            const size_t base = spans_.size();
-            size_t acc = 0;
-            double lo = tmin, hi = tmax;
-            for (uint32_t i = 0; i < node.childCount; ++i) {
-                const NodeId child = g_.child(n, i);
-                double t0 = lo, t1 = hi;
-                const bool inBox =
-                    !scene_.useBounds || clipToBox(scene_.bounds_.node[child], r.o, r.d, t0, t1);
-                if (!inBox) {
-                    // Outside the window: empty there. An intersection becomes empty, and
-                    // so does a difference whose first operand is.
-                    if (node.kind == NodeKind::Intersection ||
-                        (node.kind == NodeKind::Difference && i == 0)) {
-                        spans_.resize(base);
-                        return 0;
-                    }
-                    continue;
-                }
-                const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
-                const size_t cbase = base + acc;
-                const size_t count = spans(child, r, cc, lo, hi);
-                if (count == 0) {
-                    if (node.kind == NodeKind::Intersection ||
-                        (node.kind == NodeKind::Difference && i == 0)) {
-                        spans_.resize(base);
-                        return 0;
-                    }
-                    continue;
-                }
-                if (i == 0 || (node.kind == NodeKind::Union && acc == 0)) {
-                    acc = count;  // already at base
-                } else {
-                    // Combine [base, base+acc) with [cbase, cbase+count) above them, then
-                    // move the result down to base.
-                    const size_t rbase = cbase + count;
-                    spans_.resize(rbase + acc + count);
-                    Span* s = spans_.data();
-                    size_t m = 0;
-                    switch (node.kind) {
-                        case NodeKind::Union:
-                            m = uniteSpans(s + base, acc, s + cbase, count, s + rbase);
-                            break;
-                        case NodeKind::Intersection:
-                            m = intersectSpans(s + base, acc, s + cbase, count, s + rbase);
-                            break;
-                        default:
-                            m = subtractSpans(s + base, acc, s + cbase, count, s + rbase);
-                            break;
-                    }
-                    std::memmove(static_cast<void*>(s + base), s + rbase, m * sizeof(Span));
-                    acc = m;
-                    spans_.resize(base + acc);
-                    if (acc == 0 && node.kind != NodeKind::Union) return 0;
-                }
-                // ∩ and \ never grow beyond their first operand: narrow the window.
-                if (node.kind != NodeKind::Union) {
-                    lo = std::max(lo, spans_[base].in.t);
-                    hi = std::min(hi, spans_[base + acc - 1].out.t);
-                }
-            }
-            return acc;
-        }
+        case NodeKind::Difference:
+            return combineOperands(
+                node.kind, node.childCount, spans_, tmin, tmax,
+                [&](uint32_t i, double lo, double hi) {
+                    return !scene_.useBounds ||
+                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, lo, hi);
+                },
+                [&](uint32_t i, double lo, double hi) {
+                    const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
+                    return spans(g_.child(n, i), r, cc, lo, hi);
+                });
         case NodeKind::Primitive: {
             const Primitive& p = g_.primitives[node.payload];
             if (isTriangle(p.kind)) return 0;  // surfaces: never under ∩ or \ (the compiler checks)

@@ -40,6 +40,7 @@
 
 #include "bounds.h"
 #include "instance_boxes.h"
+#include "operators.h"
 #include "eval.h"
 #include "graph.h"
 #include "primitives.h"
@@ -108,21 +109,11 @@ class Tracer {
     uintptr_t stackLowWater() const { return lowWater_; }
 
   private:
-    struct LRay {
-        Vec3 o, d;
-    };
     struct Ctx {
         const double* frame;
         uint64_t path;
         uint32_t depth;
         uint32_t material;
-    };
-    struct LocalHit {
-        double t = 0;
-        Vec3 normal;
-        uint32_t material = 0;
-        bool valid = false;  // a surface was found
-        uint64_t key = 0;    // the instance path of what was hit: breaks ties in t
     };
 
     // Parameter frames: a stack of fixed-size blocks (addresses stay valid while deeper
@@ -140,11 +131,9 @@ class Tracer {
         size_t used_ = 0;
     };
 
-    bool first(NodeId n, const LRay& r, const Ctx& c, double tmin, double& tmax, LocalHit& hit);
-    size_t spans(NodeId n, const LRay& r, const Ctx& c, double tmin, double tmax);
-    bool boundaryHit(size_t base, size_t count, double tmin, double tmax, uint64_t key,
-                     LocalHit& hit);
-    bool selectCulled(NodeId n, const LRay& r, const Ctx& c, uint32_t depth, double tmin,
+    bool first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit);
+    size_t spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax);
+    bool selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
                       double tmax);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
     void checkStack();

@@ -1,0 +1,173 @@
+// What ∪ ∩ \ do with one ray, shared by the walk of the cyclic graph (traversal.cpp) and
+// the walk of expanded sub-graph instances (expanded_instances.cpp), so that both find
+// the same surface by the same arithmetic:
+//
+//  - first hit of a union: operands front to back by the entry of the ray into their
+//    boxes, stopping when the next box starts beyond the nearest hit so far;
+//  - span lists of ∪ ∩ \ (Roth 1982): operands combined one by one with span_list.h,
+//    the window of t narrowed by the first operand of ∩ and \;
+//  - the first boundary of a span list;
+//  - ties: of two surfaces at exactly the same t, the one with the smaller instance path
+//    wins, whatever the order the walk found them in.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+#include "geometry.h"
+#include "graph.h"
+#include "primitives.h"
+#include "span_list.h"
+
+namespace pcsg::tracer {
+
+// A ray in some node's frame: the direction is never normalised, so t is the same number
+// in every frame.
+struct LocalRay {
+    Vec3 o, d;
+};
+
+// The nearest surface found so far.
+struct Hit {
+    double t = 0;
+    Vec3 normal;  // in the frame of the node that returned it
+    uint32_t material = 0;
+    bool valid = false;  // a surface was found
+    uint64_t key = 0;    // the instance path of what was hit: breaks ties in t
+};
+
+// Does a surface at t from the instance `key` replace the nearest one so far (at tmax)?
+inline bool nearer(double t, uint64_t key, double tmax, const Hit& hit) {
+    return t < tmax || (t == tmax && hit.valid && key < hit.key);
+}
+
+// Clips [t0, t1] to the part of the line inside the box; false when nothing is left.
+inline bool clipToBox(const Box& b, const Vec3& o, const Vec3& d, double& t0, double& t1) {
+    if (b.lo.x > b.hi.x) return false;  // empty
+    for (int i = 0; i < 3; ++i) {
+        if (d[i] == 0) {
+            if (o[i] < b.lo[i] || o[i] > b.hi[i]) return false;
+            continue;
+        }
+        const double inv = 1.0 / d[i];
+        double a = (b.lo[i] - o[i]) * inv, c = (b.hi[i] - o[i]) * inv;
+        if (a > c) std::swap(a, c);
+        if (a > t0) t0 = a;
+        if (c < t1) t1 = c;
+        if (!(t0 <= t1)) return false;
+    }
+    return true;
+}
+
+// The first hit among a union's operands. `entry(i, t0)` sets t0 to where the ray enters
+// operand i's box within [tmin, tmax] and returns false when it misses the box;
+// `first(i, tmax, hit)` looks for a nearer surface in operand i. `order` is scratch space
+// (used as a stack, so the walk may recurse).
+template <class Entry, class First>
+bool firstOfUnion(uint32_t count, double tmin, double& tmax, Hit& hit, bool anyHit,
+                  std::vector<std::pair<double, uint32_t>>& order, Entry entry, First first) {
+    const size_t base = order.size();
+    for (uint32_t i = 0; i < count; ++i) {
+        double t0 = tmin;
+        if (entry(i, t0)) order.emplace_back(t0, i);
+    }
+    const size_t end = order.size();
+    if (end - base > 1) std::sort(order.begin() + base, order.begin() + end);
+    bool found = false;
+    for (size_t k = base; k < end; ++k) {
+        const auto [t0, i] = order[k];
+        if (t0 > tmax) break;  // (at tmax exactly it may still win a tie)
+        if (first(i, tmax, hit)) {
+            found = true;
+            if (anyHit) break;
+        }
+    }
+    order.resize(base);
+    return found;
+}
+
+// The first boundary of spans[base, base + count) with tmin < t < tmax (or at tmax,
+// winning the tie): becomes `hit`.
+inline bool boundaryHit(const std::vector<Span>& spans, size_t base, size_t count, double tmin,
+                        double tmax, uint64_t key, Hit& hit) {
+    for (size_t k = 0; k < count; ++k) {
+        const Span& s = spans[base + k];
+        const Boundary* b = nullptr;
+        if (s.in.t > tmin)
+            b = &s.in;
+        else if (s.out.t > tmin)
+            b = &s.out;
+        else
+            continue;
+        if (!nearer(b->t, key, tmax, hit)) return false;
+        hit = Hit{b->t, b->normal, b->material, true, key};
+        return true;
+    }
+    return false;
+}
+
+// The span list of an operator (kind Union, Intersection or Difference) over `count`
+// operands, appended to `spans` at its end; returns the number of spans. `inWindow(i, lo,
+// hi)` says whether operand i's box meets the window [lo, hi]; `operand(i, lo, hi)`
+// appends operand i's spans and returns their number.
+template <class InWindow, class Operand>
+size_t combineOperands(NodeKind kind, uint32_t count, std::vector<Span>& spans, double tmin,
+                       double tmax, InWindow inWindow, Operand operand) {
+    const size_t base = spans.size();
+    size_t acc = 0;
+    double lo = tmin, hi = tmax;
+    for (uint32_t i = 0; i < count; ++i) {
+        // Empty in the window: an intersection becomes empty, and so does a difference
+        // whose first operand is.
+        const bool emptiesAll =
+            kind == NodeKind::Intersection || (kind == NodeKind::Difference && i == 0);
+        if (!inWindow(i, lo, hi)) {
+            if (emptiesAll) {
+                spans.resize(base);
+                return 0;
+            }
+            continue;
+        }
+        const size_t cbase = base + acc;
+        const size_t n = operand(i, lo, hi);
+        if (n == 0) {
+            if (emptiesAll) {
+                spans.resize(base);
+                return 0;
+            }
+            continue;
+        }
+        if (i == 0 || (kind == NodeKind::Union && acc == 0)) {
+            acc = n;  // already at base
+        } else {
+            // Combine [base, base+acc) with [cbase, cbase+n) above them, then move the
+            // result down to base.
+            const size_t rbase = cbase + n;
+            spans.resize(rbase + acc + n);
+            Span* s = spans.data();
+            size_t m = 0;
+            switch (kind) {
+                case NodeKind::Union: m = uniteSpans(s + base, acc, s + cbase, n, s + rbase); break;
+                case NodeKind::Intersection:
+                    m = intersectSpans(s + base, acc, s + cbase, n, s + rbase);
+                    break;
+                default: m = subtractSpans(s + base, acc, s + cbase, n, s + rbase); break;
+            }
+            std::memmove(static_cast<void*>(s + base), s + rbase, m * sizeof(Span));
+            acc = m;
+            spans.resize(base + acc);
+            if (acc == 0 && kind != NodeKind::Union) return 0;
+        }
+        // ∩ and \ never grow beyond their first operand: narrow the window.
+        if (kind != NodeKind::Union) {
+            lo = std::max(lo, spans[base].in.t);
+            hi = std::min(hi, spans[base + acc - 1].out.t);
+        }
+    }
+    return acc;
+}
+
+}  // namespace pcsg::tracer
