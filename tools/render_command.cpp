@@ -3,9 +3,12 @@
 // Ray traces the scene's cyclic graph directly (tracer/): the graph is never expanded.
 // Prints the figures of the paper's Table 1 and more (tools/stats.h).
 //
-// The image file is written by the pcsg-image helper (tools/image_helper.h): this process
-// renders, then pipes its linear float pixels to `pcsg-image write`, so that it never
-// loads OpenImageIO. Its peak RSS is its own (getrusage RUSAGE_SELF); the writer's is
+// The image file is written by the pcsg-image helper (tools/image_helper.h), so that this
+// process never loads OpenImageIO: `pcsg-image write` is started as soon as the scene
+// compiles, loads its libraries (about half a second) while this process renders, and then
+// gets the linear float pixels through a pipe. When the scene fails at run time, the
+// helper is killed and reaped before it has written or said anything. The render's peak
+// RSS is its own (getrusage RUSAGE_SELF: the helper is another process); the helper's is
 // printed beside it.
 //
 // Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
@@ -50,6 +53,7 @@ struct RenderCommandOptions {
     bool noBounds = false;
     bool noInstanceBoxes = false;
     size_t boxCacheMb = 64;
+    size_t expansionCacheMb = 16;
     uint64_t countVisits = 20'000'000;
 };
 
@@ -116,6 +120,9 @@ int runRender(const RenderCommandOptions& o) {
     const CompiledScene compiled = compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
     const Graph& g = *compiled.graph;
+    // The writer starts now, so that its start-up overlaps the count and the render; every
+    // return below without an image abandons it (the destructor, if not explicitly).
+    ImageWriter writer(*imageHelper, o.output, o.width, o.height);
 
     Stats s;
     s.scene = o.scene;
@@ -133,6 +140,7 @@ int runRender(const RenderCommandOptions& o) {
         co.maxVisits = o.countVisits;
         count = countExpansion(g, co);
     } catch (const RuntimeError& e) {
+        std::cerr << writer.finish({}).error << "\n";  // MUTATION
         std::cerr << e.format(g) << "\n";
         return 1;
     }
@@ -147,6 +155,7 @@ int runRender(const RenderCommandOptions& o) {
     ro.useBounds = !o.noBounds;
     ro.instanceBoxes = !o.noInstanceBoxes;
     ro.instanceBoxBytes = o.boxCacheMb << 20;
+    ro.expansionBytesPerThread = o.expansionCacheMb << 20;
     auto bar = std::make_shared<ProgressBar>();
     const bool showProgress = isatty(STDERR_FILENO) != 0;
     if (showProgress) ro.progress = [bar](double f) { bar->update(f); };
@@ -156,17 +165,18 @@ int runRender(const RenderCommandOptions& o) {
         result = tracer::render(g, ro);
     } catch (const RuntimeError& e) {
         if (showProgress) bar->finish();
+        writer.abandon();
         std::cerr << e.format(g) << "\n";
         return 1;
     } catch (const std::exception& e) {
         if (showProgress) bar->finish();
+        writer.abandon();
         std::cerr << "pcsg render: error: " << o.scene << ": " << e.what() << "\n";
         return 2;
     }
     if (showProgress) bar->finish();
 
-    const ImageWriteResult written =
-        writeImageWithHelper(*imageHelper, o.output, o.width, o.height, result.rgb);
+    const ImageWriteResult written = writer.finish(result.rgb);
     if (!written.ok) {
         std::cerr << "pcsg render: " << written.error << "\n";
         return 2;
@@ -187,11 +197,14 @@ int runRender(const RenderCommandOptions& o) {
                                {"bytes", result.instanceBoxes.bytes},
                                {"computed", result.instanceBoxes.computed},
                                {"full", result.instanceBoxes.full}};
+        j["expanded_instances"] = result.expansions;
         j["aa"] = o.aa;
         j["adaptive"] = o.adaptive;
         j["graph_nodes"] = g.nodes.size();
         j["image_writer_peak_rss_bytes"] = written.peakRssBytes;
+        // After the render: the part of the wall time spent on the image.
         j["image_write_seconds"] = written.seconds;
+        j["image_writer_seconds"] = written.helperSeconds;  // its whole life, start-up included
         if (!count.complete) j["primitive_equivalence_note"] = "too large to count (rand/choose)";
         std::cout << j.dump(2) << "\n";
     } else {
@@ -208,9 +221,9 @@ int runRender(const RenderCommandOptions& o) {
                                      result.instanceBoxes.entries,
                                      humanBytes(result.instanceBoxes.bytes),
                                      result.instanceBoxes.full ? " (full)" : "");
-        std::cout << fmt::format("{:<24}{} ({}, {:.3f} s)\n", "image writer peak RSS",
-                                 humanBytes(written.peakRssBytes), kImageHelperName,
-                                 written.seconds);
+        std::cout << fmt::format("{:<24}{} ({}, {:.3f} s after the render)\n",
+                                 "image writer peak RSS", humanBytes(written.peakRssBytes),
+                                 kImageHelperName, written.seconds);
     }
     return 0;
 }
@@ -227,7 +240,8 @@ void addRenderCommand(CLI::App& app, int& status) {
         "of `pcsg export-pov`. Prints rays, rays per second, primitive equivalence (the "
         "primitives the expanded tree would hold), graph bytes, peak memory and time. The "
         "image file is written by the pcsg-image helper (found beside pcsg, or in PATH), which "
-        "gets the pixels through a pipe; its peak memory is printed separately.\n"
+        "starts while the scene renders and then gets the pixels through a pipe; its peak "
+        "memory is printed separately.\n"
         "Exit status: 0 written, 1 the scene has an error (nothing written), 2 could not run.");
     cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input)")->required();
     cmd->add_option("-o,--output", o->output, "The image to write: .png, .exr, .tif or .tiff")
@@ -254,6 +268,12 @@ void addRenderCommand(CLI::App& app, int& status) {
     cmd->add_option("--box-cache-mb", o->boxCacheMb,
                     "Memory limit of the instance-box cache in MB (the exact boxes of sub-graph "
                     "instances, filled lazily while rendering)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
+    cmd->add_option("--expansion-cache-mb", o->expansionCacheMb,
+                    "Memory limit per thread, in MB, of the cache of expanded sub-graph "
+                    "instances (small instances unrolled once and traced as flat arrays; 0: "
+                    "none; the image is the same)")
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--count-visits", o->countVisits,

@@ -245,14 +245,20 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds, const Instanc
       levels_(g.scene.settings.maxDepth + 2) {
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);
     decision_ = std::make_unique<std::atomic<uint8_t>[]>(n);
+    expand_ = std::make_unique<std::atomic<uint8_t>[]>(n);
     tried_ = std::make_unique<std::atomic<uint32_t>[]>(n);
     paid_ = std::make_unique<std::atomic<uint32_t>[]>(n);
+    minWeight_ = std::make_unique<std::atomic<uint64_t>[]>(n);
+    maxWeight_ = std::make_unique<std::atomic<uint64_t>[]>(n);
     for (size_t i = 0; i < n; ++i) {
         // Modules whose dependencies could not be analysed cannot be keyed: static only.
         const bool analysed = deps_[i / levels_].analysed;
         decision_[i].store(analysed ? 0 : 2, std::memory_order_relaxed);
+        expand_[i].store(0, std::memory_order_relaxed);
         tried_[i].store(0, std::memory_order_relaxed);
         paid_[i].store(0, std::memory_order_relaxed);
+        minWeight_[i].store(UINT64_MAX, std::memory_order_relaxed);
+        maxWeight_[i].store(0, std::memory_order_relaxed);
     }
 }
 
@@ -266,6 +272,12 @@ bool InstanceBoxes::useAt(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return false;
     const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
     return decision_[i].load(std::memory_order_relaxed) != 2;
+}
+
+bool InstanceBoxes::expandAt(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return false;
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    return expand_[i].load(std::memory_order_relaxed) != 0;
 }
 
 InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint64_t path) const {
@@ -300,9 +312,18 @@ void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const
         }
     }
     if (pays) paid_[i].fetch_add(1, std::memory_order_relaxed);
+    uint64_t seen = minWeight_[i].load(std::memory_order_relaxed);
+    while (s.weight < seen && !minWeight_[i].compare_exchange_weak(seen, s.weight)) {
+    }
+    seen = maxWeight_[i].load(std::memory_order_relaxed);
+    while (s.weight > seen && !maxWeight_[i].compare_exchange_weak(seen, s.weight)) {
+    }
     const uint32_t tried = tried_[i].fetch_add(1, std::memory_order_relaxed) + 1;
     if (tried >= opt_.trial) {
         const uint32_t paid = paid_[i].load(std::memory_order_relaxed);
+        const bool expand = minWeight_[i].load(std::memory_order_relaxed) >= opt_.minExpandWeight &&
+                            maxWeight_[i].load(std::memory_order_relaxed) <= opt_.maxExpandWeight;
+        expand_[i].store(expand ? 1 : 0, std::memory_order_relaxed);
         decision_[i].store(paid * 2 >= tried ? 1 : 2, std::memory_order_relaxed);
     }
 }

@@ -53,6 +53,10 @@ struct InstanceBoxOptions {
     // An exact box "pays" when it is smaller than the static box by this factor along
     // some axis.
     double gain = 0.8;
+    // Depths whose instances all took between these many visits to unroll are worth
+    // expanding (expanded_instances.h).
+    uint64_t minExpandWeight = 12;
+    uint64_t maxExpandWeight = 1024;
 };
 
 struct InstanceBoxStats {
@@ -71,6 +75,18 @@ class InstanceBoxes {
 
     // Whether exact boxes are used for this S-node at this depth (see above).
     bool useAt(NodeId select, uint32_t depth) const;
+    // Whether the instances of this S-node at this depth are worth expanding: decided
+    // with useAt, from the sizes of the first instances met there.
+    bool expandAt(NodeId select, uint32_t depth) const;
+    uint64_t maxExpandWeight() const { return opt_.maxExpandWeight; }
+
+    // An instance: its S-node, the values of the parameters its sub-graph reads and, when
+    // it calls rand() or choose(), its instance path, hashed to 128 bits.
+    struct Key {
+        uint64_t a = 0, b = 0;
+        bool operator==(const Key&) const = default;
+    };
+    Key keyOf(NodeId select, const double* frame, uint64_t path) const;
 
     // What a thread needs to unroll instances (the walk's stacks): one per thread.
     class Worker;
@@ -89,17 +105,12 @@ class InstanceBoxes {
 
   private:
     friend class BoxSink;
-    struct Key {
-        uint64_t a = 0, b = 0;
-        bool operator==(const Key&) const = default;
-    };
     struct Stored {
         Box box;
         uint64_t weight = 0;
     };
     class Table;
 
-    Key keyOf(NodeId select, const double* frame, uint64_t path) const;
     bool find(const Key& k, Stored& out) const;
     void insert(const Key& k, const Stored& s) const;
     void record(NodeId select, uint32_t depth, const Stored& s) const;
@@ -111,11 +122,12 @@ class InstanceBoxes {
     std::unique_ptr<Table> table_;
     mutable std::atomic<uint64_t> computed_{0};
 
-    // Per (module, depth < levels_): 0 undecided, 1 use exact boxes, 2 static only; and
-    // the trial counters.
+    // Per (module, depth < levels_): 0 undecided, 1 use exact boxes, 2 static only;
+    // whether to expand; and the trial counters.
     uint32_t levels_ = 0;
-    mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_;
+    mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_, expand_;
     mutable std::unique_ptr<std::atomic<uint32_t>[]> tried_, paid_;
+    mutable std::unique_ptr<std::atomic<uint64_t>[]> minWeight_, maxWeight_;
 };
 
 }  // namespace pcsg::tracer

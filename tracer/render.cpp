@@ -93,6 +93,7 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
     boxOptions.maxBytes = opt.instanceBoxBytes;
     TraceScene scene(g, std::move(bounds), opt.instanceBoxes, boxOptions);
     scene.useBounds = opt.useBounds;
+    scene.expansionBytesPerThread = opt.expansionBytesPerThread;
     const PinholeCamera camera(g.scene.camera, opt.width, opt.height);
     const size_t stack = scene.stackBytesNeeded();
 
@@ -195,6 +196,7 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
             if (wp) {
                 result.rays += wp->shader.rays();
                 result.nodeVisits += wp->shader.nodeVisits();
+                result.expansions += wp->shader.tracer().expansions();
             }
     };
     runWithStack(stack, work);

@@ -41,6 +41,9 @@ struct RenderOptions {
     // kept in a table of at most this many bytes.
     bool instanceBoxes = true;
     size_t instanceBoxBytes = 64u << 20;
+    // Expanded instances (expanded_instances.h), each thread's cache holding at most this
+    // many bytes; 0: none.
+    size_t expansionBytesPerThread = 16u << 20;
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
 };
@@ -54,6 +57,7 @@ struct RenderResult {
     double boundsSeconds = 0;    // computing the hyper-bounding boxes
     uint32_t infiniteBoxes = 0;  // nodes left with unbounded boxes
     InstanceBoxStats instanceBoxes;  // the instance-box cache at the end
+    uint64_t expansions = 0;         // sub-graph instances expanded (all threads)
 };
 
 // Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)

@@ -134,6 +134,20 @@ Tracer::Tracer(const TraceScene& scene)
     rootFrame_.assign(std::max<size_t>(g_.slotCount(), 1), 0.0);
     initFrame(g_, rootFrame_.data());
     if (scene.instanceBoxes_) boxWorker_ = scene.instanceBoxes_->makeWorker();
+    if (scene.instanceBoxes_ && scene.expansionBytesPerThread > 0)
+        expansion_ = std::make_unique<ExpansionCache>(scene, scene.expansionBytesPerThread);
+}
+
+Tracer::~Tracer() = default;
+
+// The expanded instance to trace instead of walking below S-node n, if there is one.
+const ExpandedInstance* Tracer::expanded(NodeId n, const Ctx& c, uint32_t depth) {
+    if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->expandAt(n, depth))
+        return nullptr;
+    const ExpandedInstance* x = expansion_->get(n, depth, c.frame, c.path);
+    // Used only where its deepest S-node stays within max_depth (else the walk reports it).
+    if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
+    return x;
 }
 
 // Whether the ray misses the S-node n (at `depth`) within [tmin, tmax]: its box at that
@@ -203,6 +217,9 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 checkDepth(g_, n, depth, st);
                 checkStack();
                 if (selectCulled(n, r, c, depth, tmin, tmax)) return false;
+                if (const ExpandedInstance* x = expanded(n, c, depth))
+                    return x->first(r, tmin, tmax, hit, {c.path, c.material}, anyHit_,
+                                    expansion_->scratch());
                 const uint32_t rule = selectRule(g_, n, st);
                 const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
                 return first(g_.child(n, rule), r, cc, tmin, tmax, hit);
@@ -303,6 +320,9 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
                 checkDepth(g_, n, depth, st);
                 checkStack();
                 if (selectCulled(n, r, c, depth, tmin, tmax)) return 0;
+                if (const ExpandedInstance* x = expanded(n, c, depth))
+                    return x->spans(r, tmin, tmax, spans_, {c.path, c.material},
+                                    expansion_->scratch());
                 const uint32_t rule = selectRule(g_, n, st);
                 const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
                 return spans(g_.child(n, rule), r, cc, tmin, tmax);

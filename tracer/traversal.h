@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "bounds.h"
+#include "expanded_instances.h"
 #include "instance_boxes.h"
 #include "operators.h"
 #include "eval.h"
@@ -74,6 +75,15 @@ class TraceScene {
     // The exact boxes of instances (nullptr: static boxes only).
     const InstanceBoxes* instanceBoxes() const { return instanceBoxes_.get(); }
 
+    // Expanded instances (expanded_instances.h): each tracer's cache may hold this many
+    // bytes; 0 turns them off.
+    size_t expansionBytesPerThread = 16u << 20;
+
+    // How the walk applies T-node n: when n starts a chain of constant T-nodes, the chain's
+    // end and the inverse of the chain's product (as one matrix); else kNone.
+    NodeId fusedTarget(NodeId n) const { return target_[n]; }
+    const Affine& fusedInverse(NodeId n) const { return inverse_[n]; }
+
   private:
     friend class Tracer;
     const Graph& g_;
@@ -95,6 +105,7 @@ class StackExhausted : public std::runtime_error {
 class Tracer {
   public:
     explicit Tracer(const TraceScene& scene);
+    ~Tracer();
 
     // The nearest surface with tmin < t < tmax along origin + t dir (dir in world space;
     // t is the distance when dir has unit length). Throws RuntimeError (with its module
@@ -104,7 +115,12 @@ class Tracer {
     // Any surface with tmin < t < tmax (shadow rays): stops at the first one found.
     bool anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tmax);
 
-    uint64_t nodeVisits() const { return visits_; }
+    // Node visits, of the graph and of expanded instances.
+    uint64_t nodeVisits() const { return visits_ + (expansion_ ? expansion_->scratch().visits : 0); }
+    // Instances this tracer expanded, and what its cache of them holds now.
+    uint64_t expansions() const { return expansion_ ? expansion_->expansions() : 0; }
+    size_t expansionCacheBytes() const { return expansion_ ? expansion_->bytes() : 0; }
+    size_t expansionCacheEntries() const { return expansion_ ? expansion_->entries() : 0; }
     // The lowest stack address a walk reached (for the stack-size test).
     uintptr_t stackLowWater() const { return lowWater_; }
 
@@ -135,6 +151,7 @@ class Tracer {
     size_t spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax);
     bool selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
                       double tmax);
+    const ExpandedInstance* expanded(NodeId n, const Ctx& c, uint32_t depth);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
     void checkStack();
 
@@ -142,6 +159,7 @@ class Tracer {
     const Graph& g_;
     FrameStack frames_;
     InstanceBoxes::WorkerPtr boxWorker_;
+    std::unique_ptr<ExpansionCache> expansion_;
     std::vector<double> rootFrame_;
     std::vector<Span> spans_;
     std::vector<std::pair<double, uint32_t>> order_;

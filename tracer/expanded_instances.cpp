@@ -1,0 +1,431 @@
+// Expanded instances: see expanded_instances.h.
+#include "expanded_instances.h"
+
+#include <cmath>
+#include <limits>
+
+#include "bounds.h"
+#include "eval.h"
+#include "traversal.h"
+
+namespace pcsg::tracer {
+
+namespace {
+
+constexpr uint32_t kRuleBit = 1u << 31;
+
+// The expansion took more visits than its depth promised: leave it to the graph walk.
+struct TooLarge {};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// Building: a walk of the graph below one S-node instance that mirrors the tracer's walk
+// (traversal.cpp) exactly: the same selections, C-nodes and T-node inverses (fused along
+// constant chains as TraceScene fuses them), in the same order.
+
+class ExpansionBuilder {
+  public:
+    ExpansionBuilder(const TraceScene& scene, ExpandedInstance& out, uint64_t maxVisits)
+        : scene_(scene), g_(scene.graph()), out_(out), maxVisits_(maxVisits) {}
+
+    void run(NodeId select, uint32_t depth, const double* frame, uint64_t path) {
+        frames_.emplace_back(frame, frame + g_.slotCount());
+        const uint32_t rule = selectRule(g_, select, EvalState{frame, path});
+        choices_.push_back(kRuleBit | rule);
+        base_ = depth;
+        out_.root_ = build(g_.child(select, rule), 0, pathRule(path, rule), depth,
+                           ExpandedInstance::kInherit, 0, Affine::identity());
+        out_.nodes_.shrink_to_fit();
+        out_.children_.shrink_to_fit();
+        out_.matrices_.shrink_to_fit();
+        out_.args_.shrink_to_fit();
+        out_.choices_.shrink_to_fit();
+    }
+
+  private:
+    using Node = ExpandedInstance::Node;
+    using Kind = ExpandedInstance::Kind;
+
+    // Builds what node n holds; returns its index, or kNone when it holds nothing. The
+    // inverse matrices in pending_[pendingBase..] and the forward map `edge` lead from
+    // the frame of the last operator above (or the S-node) to n's frame.
+    uint32_t build(NodeId n, size_t frame, uint64_t path, uint32_t depth, uint32_t material,
+                   size_t pendingBase, const Affine& edge) {
+        if (++visits_ > maxVisits_) throw TooLarge{};
+        const ::pcsg::Node& node = g_.nodes[n];
+        switch (node.kind) {
+            case NodeKind::Select: {
+                const uint32_t d = depth + 1;
+                const EvalState st{frames_[frame].data(), path};
+                try {
+                    checkDepth(g_, n, d, st);
+                    out_.levels_ = std::max(out_.levels_, d - base_);
+                    const uint32_t rule = selectRule(g_, n, st);
+                    choices_.push_back(kRuleBit | rule);
+                    const uint32_t r = build(g_.child(n, rule), frame, pathRule(path, rule), d,
+                                             material, pendingBase, edge);
+                    choices_.pop_back();
+                    return r;
+                } catch (RuntimeError& e) {
+                    e.enterModule(g_.modules[node.payload].name);
+                    throw;
+                }
+            }
+            case NodeKind::Calc: {
+                std::vector<double> next(g_.slotCount());
+                applyCalc(g_, n, EvalState{frames_[frame].data(), path}, next.data());
+                frames_.push_back(std::move(next));
+                const uint32_t r = build(g_.child(n), frames_.size() - 1, path, depth, material,
+                                         pendingBase, edge);
+                frames_.pop_back();
+                return r;
+            }
+            case NodeKind::Transform: {
+                // As Tracer::first: a fused constant chain, or this T-node's inverse.
+                NodeId target = scene_.fusedTarget(n);
+                Affine inverse, forward;
+                if (target != kNone) {
+                    inverse = scene_.fusedInverse(n);
+                    forward = Affine::identity();
+                    for (NodeId m = n; m != target; m = g_.child(m))
+                        forward = forward * g_.transforms[g_.nodes[m].payload].matrix;
+                } else {
+                    forward = transformMatrix(g_, n, EvalState{frames_[frame].data(), path});
+                    inverse = forward.inverse();
+                    target = g_.child(n);
+                }
+                pending_.push_back(inverse);
+                const uint32_t r =
+                    build(target, frame, path, depth, material, pendingBase, edge * forward);
+                pending_.pop_back();
+                return r;
+            }
+            case NodeKind::Paint:
+                return build(g_.child(n), frame, path, depth, node.payload, pendingBase, edge);
+            case NodeKind::Union:
+            case NodeKind::Intersection:
+            case NodeKind::Difference: {
+                const Kind kind = node.kind == NodeKind::Union          ? Kind::Union
+                                  : node.kind == NodeKind::Intersection ? Kind::Intersection
+                                                                        : Kind::Difference;
+                std::vector<uint32_t> kids;
+                const size_t mark = pending_.size();
+                for (uint32_t i = 0; i < node.childCount; ++i) {
+                    choices_.push_back(i);
+                    const uint32_t c = build(g_.child(n, i), frame, pathChild(path, i), depth,
+                                             material, mark, Affine::identity());
+                    choices_.pop_back();
+                    if (c == kNone) {
+                        // Nothing there: an intersection holds nothing, and so does a
+                        // difference whose first operand holds nothing.
+                        if (kind == Kind::Intersection || (kind == Kind::Difference && i == 0))
+                            return kNone;
+                        continue;
+                    }
+                    kids.push_back(c);
+                }
+                if (kids.empty()) return kNone;
+                Box inside = out_.nodes_[kids[0]].box;
+                for (size_t k = 1; k < kids.size(); ++k) {
+                    const Box& b = out_.nodes_[kids[k]].box;
+                    if (kind == Kind::Union) inside.extend(b);
+                    if (kind == Kind::Intersection) inside = intersect(inside, b);
+                }
+                Node x = emit(kind, material, pendingBase, edge, inside);
+                x.first = static_cast<uint32_t>(out_.children_.size());
+                x.count = static_cast<uint32_t>(kids.size());
+                out_.children_.insert(out_.children_.end(), kids.begin(), kids.end());
+                if (kind != Kind::Union) setChoices(x);
+                out_.nodes_.push_back(x);
+                return static_cast<uint32_t>(out_.nodes_.size() - 1);
+            }
+            case NodeKind::Primitive: {
+                const Primitive& p = g_.primitives[node.payload];
+                if (p.kind == PrimitiveKind::Empty) return kNone;
+                double args[9] = {};
+                const uint32_t argc = storedArgs(p.kind);
+                if (p.kind == PrimitiveKind::Torus || isTriangle(p.kind))
+                    primitiveArgs(g_, n, EvalState{frames_[frame].data(), path}, args);
+                Box own;
+                if (isTriangle(p.kind)) {
+                    Vec3 corners[3];
+                    triangleCorners(p.kind, args, corners);
+                    for (const Vec3& c : corners) own.extend(c);
+                } else {
+                    own = primitiveBox(p.kind, args);
+                }
+                Node x = emit(isTriangle(p.kind) ? Kind::Triangle : Kind::Solid, material,
+                              pendingBase, edge, own);
+                x.prim = p.kind;
+                x.first = static_cast<uint32_t>(out_.args_.size());
+                x.count = argc;
+                out_.args_.insert(out_.args_.end(), args, args + argc);
+                setChoices(x);
+                out_.nodes_.push_back(x);
+                return static_cast<uint32_t>(out_.nodes_.size() - 1);
+            }
+        }
+        return kNone;
+    }
+
+    // A node entered through the matrices pending_[pendingBase..], holding `inside` (in
+    // its own frame).
+    Node emit(Kind kind, uint32_t material, size_t pendingBase, const Affine& edge,
+              const Box& inside) {
+        Node x{};
+        x.kind = kind;
+        x.material = material;
+        x.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
+        x.matrices = static_cast<uint32_t>(pending_.size() - pendingBase);
+        out_.matrices_.insert(out_.matrices_.end(), pending_.begin() + pendingBase,
+                              pending_.end());
+        x.box = inside.isEmpty() ? Box::empty() : paddedBox(transformBox(edge, inside));
+        return x;
+    }
+
+    void setChoices(Node& x) {
+        x.firstChoice = static_cast<uint32_t>(out_.choices_.size());
+        x.choices = static_cast<uint32_t>(choices_.size());
+        out_.choices_.insert(out_.choices_.end(), choices_.begin(), choices_.end());
+    }
+
+    const TraceScene& scene_;
+    const Graph& g_;
+    ExpandedInstance& out_;
+    const uint64_t maxVisits_;
+    uint64_t visits_ = 0;
+    uint32_t base_ = 0;
+    std::vector<std::vector<double>> frames_;
+    std::vector<Affine> pending_;
+    std::vector<uint32_t> choices_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Tracing: Tracer::first and Tracer::spans on the flat arrays.
+
+size_t ExpandedInstance::bytes() const {
+    return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
+           children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
+           args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t);
+}
+
+LocalRay ExpandedInstance::enter(const Node& node, const LocalRay& r) const {
+    LocalRay rr = r;
+    for (uint32_t k = 0; k < node.matrices; ++k) {
+        const Affine& m = matrices_[node.firstMatrix + k];
+        rr = LocalRay{m.point(rr.o), m.vector(rr.d)};
+    }
+    return rr;
+}
+
+Vec3 ExpandedInstance::leave(const Node& node, Vec3 normal) const {
+    for (uint32_t k = node.matrices; k-- > 0;)
+        normal = matrices_[node.firstMatrix + k].transposedVector(normal);
+    return normal;
+}
+
+uint64_t ExpandedInstance::keyOf(const Node& node, uint64_t path) const {
+    for (uint32_t k = 0; k < node.choices; ++k) {
+        const uint32_t c = choices_[node.firstChoice + k];
+        path = (c & kRuleBit) ? pathRule(path, c & ~kRuleBit) : pathChild(path, c);
+    }
+    return path;
+}
+
+bool ExpandedInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                             const Use& use, bool anyHit, Scratch& s) const {
+    if (root_ == kNone) return false;
+    double t0 = tmin, t1 = tmax;
+    if (!clipToBox(nodes_[root_].box, r.o, r.d, t0, t1)) return false;
+    return firstAt(root_, r, tmin, tmax, hit, use, anyHit, s);
+}
+
+size_t ExpandedInstance::spans(const LocalRay& r, double tmin, double tmax,
+                               std::vector<Span>& spans, const Use& use, Scratch& s) const {
+    if (root_ == kNone) return 0;
+    double t0 = tmin, t1 = tmax;
+    if (!clipToBox(nodes_[root_].box, r.o, r.d, t0, t1)) return 0;
+    return spansAt(root_, r, tmin, tmax, spans, use, s);
+}
+
+bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax,
+                               Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
+    ++s.visits;
+    const Node& node = nodes_[n];
+    const LocalRay rr = enter(node, r);
+    const uint32_t material = node.material == kInherit ? use.material : node.material;
+    bool found = false;
+    switch (node.kind) {
+        case Kind::Solid: {
+            Span sp[kMaxPrimitiveSpans];
+            const int count = intersectSolid(node.prim, args_.data() + node.first, rr.o, rr.d, sp);
+            for (int k = 0; k < count; ++k) {
+                const Boundary* b =
+                    sp[k].in.t > tmin ? &sp[k].in : (sp[k].out.t > tmin ? &sp[k].out : nullptr);
+                if (!b) continue;
+                // (the key is replayed only for a tie or a new nearest hit)
+                if (!(b->t < tmax) && !(b->t == tmax && hit.valid && keyOf(node, use.path) < hit.key))
+                    break;
+                hit = Hit{b->t, b->normal, material, true, keyOf(node, use.path)};
+                tmax = b->t;
+                found = true;
+                break;
+            }
+            break;
+        }
+        case Kind::Triangle: {
+            Vec3 corners[3];
+            triangleCorners(node.prim, args_.data() + node.first, corners);
+            Boundary b;
+            if (intersectTriangle(corners[0], corners[1], corners[2], rr.o, rr.d, tmin,
+                                  std::nextafter(tmax, std::numeric_limits<double>::infinity()), b) &&
+                (b.t < tmax || (b.t == tmax && hit.valid && keyOf(node, use.path) < hit.key))) {
+                hit = Hit{b.t, b.normal, material, true, keyOf(node, use.path)};
+                tmax = b.t;
+                found = true;
+            }
+            break;
+        }
+        case Kind::Union:
+            found = firstOfUnion(
+                node.count, tmin, tmax, hit, anyHit, s.order,
+                [&](uint32_t i, double& t0) {
+                    double t1 = tmax;
+                    return clipToBox(nodes_[children_[node.first + i]].box, rr.o, rr.d, t0, t1);
+                },
+                [&](uint32_t i, double& best, Hit& h) {
+                    return firstAt(children_[node.first + i], rr, tmin, best, h, use, anyHit, s);
+                });
+            break;
+        case Kind::Intersection:
+        case Kind::Difference: {
+            std::vector<Span>& buffer = s.spans;
+            const size_t base = buffer.size();
+            const size_t count = spansAt(n, r, tmin, tmax, buffer, use, s);
+            // spansAt left the normals in the frame this node is entered from.
+            found = boundaryHit(buffer, base, count, tmin, tmax, keyOf(node, use.path), hit);
+            buffer.resize(base);
+            if (found) tmax = hit.t;
+            return found;
+        }
+    }
+    if (found) hit.normal = leave(node, hit.normal);
+    return found;
+}
+
+size_t ExpandedInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
+                                 std::vector<Span>& spans, const Use& use, Scratch& s) const {
+    ++s.visits;
+    const Node& node = nodes_[n];
+    const LocalRay rr = enter(node, r);
+    const size_t base = spans.size();
+    size_t count = 0;
+    switch (node.kind) {
+        case Kind::Triangle: return 0;  // surfaces: never under ∩ or \ (the compiler checks)
+        case Kind::Solid: {
+            Span sp[kMaxPrimitiveSpans];
+            const int k = intersectSolid(node.prim, args_.data() + node.first, rr.o, rr.d, sp);
+            const uint32_t material = node.material == kInherit ? use.material : node.material;
+            for (int j = 0; j < k; ++j) {
+                sp[j].in.material = sp[j].out.material = material;
+                spans.push_back(sp[j]);
+            }
+            count = static_cast<size_t>(k);
+            break;
+        }
+        case Kind::Union:
+        case Kind::Intersection:
+        case Kind::Difference: {
+            const NodeKind kind = node.kind == Kind::Union          ? NodeKind::Union
+                                  : node.kind == Kind::Intersection ? NodeKind::Intersection
+                                                                    : NodeKind::Difference;
+            count = combineOperands(
+                kind, node.count, spans, tmin, tmax,
+                [&](uint32_t i, double lo, double hi) {
+                    return clipToBox(nodes_[children_[node.first + i]].box, rr.o, rr.d, lo, hi);
+                },
+                [&](uint32_t i, double lo, double hi) {
+                    return spansAt(children_[node.first + i], rr, lo, hi, spans, use, s);
+                });
+            break;
+        }
+    }
+    for (size_t k = base; k < base + count; ++k) {
+        spans[k].in.normal = leave(node, spans[k].in.normal);
+        spans[k].out.normal = leave(node, spans[k].out.normal);
+    }
+    return count;
+}
+
+// ---------------------------------------------------------------------------------------
+
+ExpansionCache::ExpansionCache(const TraceScene& scene, size_t maxBytes)
+    : scene_(scene),
+      maxBytes_(maxBytes),
+      yield_(scene.graph().modules.size() * (scene.graph().scene.settings.maxDepth + 2)),
+      levels_(scene.graph().scene.settings.maxDepth + 2) {}
+
+ExpansionCache::~ExpansionCache() = default;
+
+void ExpansionCache::evict() {
+    while (bytes_ > maxBytes_ && lru_.size() > 1) {
+        const Entry& last = lru_.back();
+        bytes_ -= last.bytes;
+        index_.erase(last.key);
+        lru_.pop_back();
+    }
+}
+
+const ExpandedInstance* ExpansionCache::get(NodeId select, uint32_t depth, const double* frame,
+                                            uint64_t path) {
+    if (depth >= levels_) return nullptr;
+    Yield& y = yield_[static_cast<size_t>(scene_.graph().nodes[select].payload) * levels_ + depth];
+    if (y.off) return nullptr;
+    const InstanceBoxes* boxes = scene_.instanceBoxes();
+    const InstanceBoxes::Key key = boxes->keyOf(select, frame, path);
+    constexpr size_t kNoteBytes = sizeof(Entry) + 64;
+    const auto it = index_.find(key);
+    if (it == index_.end()) {
+        // The first meeting: only a note.
+        lru_.push_front(Entry{key, nullptr, false, kNoteBytes});
+        index_.emplace(key, lru_.begin());
+        bytes_ += kNoteBytes;
+        evict();
+        return nullptr;
+    }
+    lru_.splice(lru_.begin(), lru_, it->second);
+    Entry& e = lru_.front();
+    if (e.tooLarge) return nullptr;
+    if (e.instance) {
+        ++y.used;
+        return e.instance.get();
+    }
+    // Expansions here that are used less than four times each on average do not pay.
+    constexpr uint64_t kTrial = 64, kUses = 4;
+    if (y.built >= kTrial && y.used < kUses * y.built) {
+        y.off = true;
+        return nullptr;
+    }
+    // The second meeting: expand.
+    auto x = std::make_unique<ExpandedInstance>();
+    ExpansionBuilder builder(scene_, *x, 4 * boxes->maxExpandWeight());
+    try {
+        builder.run(select, depth, frame, path);
+    } catch (const TooLarge&) {
+        e.tooLarge = true;
+        return nullptr;
+    }
+    ++expansions_;
+    ++y.built;
+    ++y.used;
+    const size_t b = x->bytes() + kNoteBytes;
+    bytes_ += b - e.bytes;
+    e.bytes = b;
+    e.instance = std::move(x);
+    const ExpandedInstance* result = e.instance.get();
+    evict();
+    return result;
+}
+
+}  // namespace pcsg::tracer

@@ -1,0 +1,154 @@
+// Expanded instances: the tracer's lazily filled, memory-bounded cache of small sub-graph
+// instances unrolled into flat arrays (the seed paper's future-work idea of keeping
+// states of the graph, in the form issue 6 names: "a lazily filled cache of expanded
+// sub-graph instances bounded in memory").
+//
+// Deep in a recursion the graph walk spends its time on bookkeeping, not geometry: each
+// ray that reaches a flower head evaluates the selection and the C-node of every petal
+// again, rebuilds every parameter-dependent matrix and walks a chain of 21 S-nodes. An
+// expanded instance does that once: the instance's primitives and ∪ ∩ \ nodes in flat
+// arrays, each with the exact box of what it holds and with the inverse matrices the
+// graph walk would apply on the way to it (the same matrices, fused the same way, applied
+// in the same order), so a ray finds the same surface, with the same t and normal bit
+// for bit, as the graph walk would. Whether an instance was expanded therefore never
+// changes an image, and the cache can keep whatever pays.
+//
+//  - Which instances: those at the depths where InstanceBoxes has seen sub-graphs of a
+//    few dozen to a thousand node visits (InstanceBoxes::expandAt); the first S-node of
+//    such a depth on a ray's path is expanded with everything below it.
+//  - When: an instance is expanded the second time a thread meets it (the first time
+//    only leaves a note), so that instances a single ray passes do not pay for it; and a
+//    thread stops expanding at a depth where the expansions are not used several times
+//    each (a terrain's sub-triangles, each seen by a few rays only).
+//  - Where: per thread (no locks), least recently used first out, within a byte budget.
+//  - Materials and tie-break keys depend on where an instance is used, not on what it
+//    is: a primitive without a paint above it inside the instance takes the caller's
+//    material, and each hit's instance path is replayed from the S-node's path.
+#pragma once
+
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "geometry.h"
+#include "graph.h"
+#include "instance_boxes.h"
+#include "operators.h"
+
+namespace pcsg::tracer {
+
+class TraceScene;
+
+class ExpandedInstance {
+  public:
+    static constexpr uint32_t kInherit = UINT32_MAX;  // material: the caller's
+
+    enum class Kind : uint8_t { Solid, Triangle, Union, Intersection, Difference };
+
+    struct Node {
+        Kind kind;
+        PrimitiveKind prim = PrimitiveKind::Empty;
+        uint32_t material = kInherit;            // primitives: the innermost paint inside
+        uint32_t firstMatrix = 0, matrices = 0;  // inverse matrices applied on entering
+        uint32_t first = 0, count = 0;           // operators: children; primitives: args
+        uint32_t firstChoice = 0, choices = 0;   // the path from the S-node (hit sources)
+        Box box;  // what the node holds, in the frame it is entered from, padded
+    };
+
+    // Where an instance is used: the S-node's instance path and the material above it.
+    struct Use {
+        uint64_t path;
+        uint32_t material;
+    };
+
+    // Scratch space of one thread (stacks of the walk).
+    struct Scratch {
+        std::vector<std::pair<double, uint32_t>> order;
+        std::vector<Span> spans;
+        uint64_t visits = 0;
+    };
+
+    // The nearest surface with tmin < t < tmax (or at tmax, winning the tie) in the
+    // instance, the ray in the S-node's frame; `hit.normal` comes back in that frame.
+    bool first(const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
+               bool anyHit, Scratch& s) const;
+    // The instance's span list, appended to `spans` (normals in the S-node's frame).
+    size_t spans(const LocalRay& r, double tmin, double tmax, std::vector<Span>& spans,
+                 const Use& use, Scratch& s) const;
+
+    const Box& box() const { return nodes_[root_].box; }
+    bool empty() const { return root_ == kNone; }
+    // S-nodes nested below the instance's own (the expansion is used only where the
+    // deepest of them stays within max_depth).
+    uint32_t levels() const { return levels_; }
+    size_t bytes() const;
+
+  private:
+    friend class ExpansionBuilder;
+
+    bool firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                 const Use& use, bool anyHit, Scratch& s) const;
+    size_t spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
+                   std::vector<Span>& spans, const Use& use, Scratch& s) const;
+    LocalRay enter(const Node& node, const LocalRay& r) const;
+    Vec3 leave(const Node& node, Vec3 normal) const;
+    uint64_t keyOf(const Node& node, uint64_t path) const;
+
+    std::vector<Node> nodes_;
+    std::vector<uint32_t> children_;
+    std::vector<Affine> matrices_;
+    std::vector<double> args_;
+    std::vector<uint32_t> choices_;  // bit 31: a rule of an S-node, else an operand
+    uint32_t root_ = kNone;
+    uint32_t levels_ = 0;
+};
+
+// One thread's cache of expanded instances.
+class ExpansionCache {
+  public:
+    ExpansionCache(const TraceScene& scene, size_t maxBytes);
+    ~ExpansionCache();
+
+    // The expanded instance of the S-node instance (select, frame, path) at `depth`, or
+    // nullptr (not worth expanding yet, or too large). Throws RuntimeError (without this
+    // S-node in its module path) when unrolling meets a run-time error.
+    const ExpandedInstance* get(NodeId select, uint32_t depth, const double* frame,
+                                uint64_t path);
+
+    ExpandedInstance::Scratch& scratch() { return scratch_; }
+    uint64_t expansions() const { return expansions_; }
+    size_t bytes() const { return bytes_; }
+    size_t entries() const { return lru_.size(); }
+
+  private:
+    struct Entry {
+        InstanceBoxes::Key key;
+        std::unique_ptr<ExpandedInstance> instance;  // nullptr: met once, or too large
+        bool tooLarge = false;
+        size_t bytes = 0;
+    };
+    struct KeyHash {
+        size_t operator()(const InstanceBoxes::Key& k) const { return static_cast<size_t>(k.b); }
+    };
+
+    void evict();
+
+    // Per (module, depth): expansions made, and uses of them.
+    struct Yield {
+        uint64_t built = 0, used = 0;
+        bool off = false;
+    };
+    std::vector<Yield> yield_;
+    uint32_t levels_;
+    const TraceScene& scene_;
+    size_t maxBytes_;
+    size_t bytes_ = 0;
+    uint64_t expansions_ = 0;
+    std::list<Entry> lru_;  // most recently used first
+    std::unordered_map<InstanceBoxes::Key, std::list<Entry>::iterator, KeyHash> index_;
+    ExpandedInstance::Scratch scratch_;
+};
+
+}  // namespace pcsg::tracer

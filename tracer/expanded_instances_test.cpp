@@ -1,0 +1,190 @@
+// Expanded instances (expanded_instances.h): a ray finds the same surface, bit for bit,
+// through an expanded instance as through the walk of the graph; materials and ties
+// depend on where an instance is used; the cache stays within its budget.
+#include "expanded_instances.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "bounds.h"
+#include "test_support.h"
+#include "traversal.h"
+
+namespace pcsg::tracer {
+namespace {
+
+using testing::compile;
+
+// Expand wherever an instance is met a second time, from the first instance on.
+InstanceBoxOptions eager() {
+    InstanceBoxOptions o;
+    o.trial = 1;
+    o.minExpandWeight = 1;
+    o.maxExpandWeight = 1u << 20;
+    return o;
+}
+
+const char* kPlant = R"(
+material bark { color <0.4, 0.3, 0.2> }
+material leaf { color <0.2, 0.6, 0.1>  phong 0.3 }
+settings { seed 3 }
+{n = 5; a = 35} P
+P if(n > 0, choose(0.7, 0.3) + 1, 1)
+1: P -> paint(leaf) (move(0,0,0.3) scale(0.3,0.1,0.3) sphere ∩ cylinder)
+2: P -> paint(bark) scale(0.1,0.1,1) cylinder ∪
+        {n = n-1} move(0,0,1) rotz(rand()*360) (rotx(a) uscale(0.7) P ∪ roty(-a) uscale(0.6) P)
+3: P -> torus(0.5, 0.1) ∪ {n = n-1} move(0,0,0.2) zshear(0.2, 0.1) flipxz uscale(0.8) P
+)";
+
+// CSG around S-nodes: recursive operands of ∩ and \, a plane, triangles in unions.
+const char* kCsg = R"(
+material red { color <1,0,0> }
+{k = 3} (A \ move(0.3,0,0) uscale(0.6) A) ∪ paint(red) B ∪ move(0,0,-2) plane
+A if(k > 0, 2, 1)
+1: A -> sphere ∩ uscale(0.9) cube
+2: A -> {k = k-1} (move(0.5,0,0) uscale(0.6) A ∪ move(-0.5,0,0) uscale(0.6) A ∪ cone)
+B if(k > 0, 2, 1)
+1: B -> move(2,0,0) (tri1 ∪ tri2 ∪ triangle(0,0,1, 1,0,1, 0,1,1.5))
+2: B -> {k = k-1} move(0,0,0.5) rotz(30) B ∪ move(2,1,0) uscale(0.3) sphere
+)";
+
+// Two surfaces at exactly the same distance everywhere: the same sphere twice, in
+// different materials. The instance path decides, the same way both ways.
+const char* kTies = R"(
+material red { color <1,0,0> }
+material blue { color <0,0,1> }
+{n = 3} T
+T if(n > 0, 2, 1)
+1: T -> paint(red) sphere ∪ paint(blue) sphere
+2: T -> {n = n-1} (move(1,0,0) uscale(0.5) T ∪ move(-1,0,0) uscale(0.5) T)
+)";
+
+// Unpainted primitives take the material of where the instance is used.
+const char* kInherit = R"(
+material red { color <1,0,0> }
+material blue { color <0,0,1> }
+{n = 2} (paint(red) move(-1.5,0,0) S ∪ paint(blue) move(1.5,0,0) S ∪ S)
+S if(n > 0, 2, 1)
+1: S -> sphere
+2: S -> {n = n-1} (move(0.5,0,0) uscale(0.5) S ∪ move(-0.5,0,0) uscale(0.5) S)
+)";
+
+struct Rays {
+    std::vector<Vec3> o, d;
+};
+
+Rays rays(int n, uint64_t seed, double spread) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    Rays r;
+    for (int i = 0; i < n; ++i) {
+        const Vec3 o{u(rng) * 5, -6 + u(rng), u(rng) * 5};
+        const Vec3 target{u(rng) * spread, u(rng) * spread, u(rng) * spread + 0.5};
+        r.o.push_back(o);
+        r.d.push_back(normalize(target - o));
+    }
+    return r;
+}
+
+// Fires the rays twice (the second time through the expanded instances) and compares
+// every hit with the walk of the graph, bit for bit. Returns the expansions made.
+uint64_t compareWithGraphWalk(const char* text, double spread, int minHits = 200) {
+    auto c = compile(text);
+    EXPECT_TRUE(c->graph);
+    if (!c->graph) return 0;
+    const Graph& g = *c->graph;
+    TraceScene plain(g, computeBounds(g), true, eager());
+    plain.expansionBytesPerThread = 0;
+    TraceScene expanding(g, computeBounds(g), true, eager());
+    Tracer a(plain), b(expanding);
+    const Rays r = rays(1500, 7, spread);
+    int hits = 0;
+    for (int round = 0; round < 2; ++round)
+        for (size_t i = 0; i < r.o.size(); ++i) {
+            SurfaceHit ha, hb;
+            const bool fa = a.firstHit(r.o[i], r.d[i], 1e-4, 1e7, ha);
+            const bool fb = b.firstHit(r.o[i], r.d[i], 1e-4, 1e7, hb);
+            EXPECT_EQ(fa, fb) << "ray " << i;
+            EXPECT_EQ(b.anyHit(r.o[i], r.d[i], 1e-4, 1e7), fa) << "ray " << i;
+            if (!fa || !fb) continue;
+            ++hits;
+            EXPECT_EQ(ha.t, hb.t) << "ray " << i;
+            EXPECT_EQ(ha.normal, hb.normal) << "ray " << i;
+            EXPECT_EQ(ha.material, hb.material) << "ray " << i;
+        }
+    EXPECT_GT(hits, minHits);
+    EXPECT_EQ(a.expansions(), 0u);
+    return b.expansions();
+}
+
+TEST(ExpandedInstances, PlantsHitTheSameSurfacesBitForBit) {
+    EXPECT_GT(compareWithGraphWalk(kPlant, 1.5), 0u);
+}
+
+TEST(ExpandedInstances, CsgAroundSNodesHitsTheSameSurfacesBitForBit) {
+    EXPECT_GT(compareWithGraphWalk(kCsg, 2.0), 0u);
+}
+
+TEST(ExpandedInstances, TiesGoTheSameWayBothWays) {
+    EXPECT_GT(compareWithGraphWalk(kTies, 1.5, 100), 0u);
+}
+
+TEST(ExpandedInstances, UnpaintedPrimitivesTakeTheMaterialOfTheirUse) {
+    EXPECT_GT(compareWithGraphWalk(kInherit, 2.5), 0u);
+}
+
+TEST(ExpandedInstances, SierpinskiHitsTheSameSurfacesBitForBit) {
+    EXPECT_GT(compareWithGraphWalk(testing::kSierpinski, 1.0), 0u);
+}
+
+TEST(ExpandedInstances, TheCacheStaysWithinItsBudget) {
+    auto c = compile(kPlant);
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    scene.expansionBytesPerThread = 8 * 1024;
+    Tracer t(scene);
+    const Rays r = rays(2000, 11, 1.5);
+    for (int round = 0; round < 2; ++round)
+        for (size_t i = 0; i < r.o.size(); ++i) {
+            SurfaceHit h;
+            t.firstHit(r.o[i], r.d[i], 1e-4, 1e7, h);
+        }
+    EXPECT_GT(t.expansions(), 0u);
+    EXPECT_GT(t.expansionCacheBytes(), 0u);
+    // What stays in a tracer's cache fits its budget, unless it is the one entry in use.
+    EXPECT_TRUE(t.expansionCacheBytes() <= scene.expansionBytesPerThread ||
+                t.expansionCacheEntries() == 1)
+        << t.expansionCacheBytes() << " bytes in " << t.expansionCacheEntries() << " entries";
+}
+
+TEST(ExpandedInstances, MaxDepthIsStillReportedBelowAnExpandableDepth) {
+    // The instances at depth 1 are small, but the chain goes on beyond max_depth 6: the
+    // walk must still meet (and report) the error, expanded or not.
+    auto c = compile(R"(
+settings { max_depth 6 }
+{n = 9} S
+S if(n > 0, 2, 1)
+1: S -> sphere
+2: S -> {n = n-1} (uscale(0.9) S ∪ move(0,0,2) cube)
+)");
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    Tracer t(scene);
+    const Rays r = rays(50, 5, 0.5);
+    bool thrown = false;
+    for (int round = 0; round < 2 && !thrown; ++round)
+        for (size_t i = 0; i < r.o.size() && !thrown; ++i) {
+            SurfaceHit h;
+            try {
+                t.firstHit(r.o[i], r.d[i], 1e-4, 1e7, h);
+            } catch (const RuntimeError& e) {
+                thrown = true;
+                EXPECT_NE(e.message.find("max_depth"), std::string::npos) << e.message;
+            }
+        }
+    EXPECT_TRUE(thrown);
+}
+
+}  // namespace
+}  // namespace pcsg::tracer
