@@ -1,6 +1,7 @@
 #include "child_process.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/resource.h>
@@ -8,11 +9,8 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <functional>
 #include <sstream>
 
 extern char** environ;
@@ -20,122 +18,268 @@ extern char** environ;
 namespace pcsg::tools {
 
 namespace {
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+
+void closeFd(int& fd) {
+    if (fd >= 0) close(fd);
+    fd = -1;
 }
 
-// Writes all of `data` to the pipe `fd`, stopping early when the reader is gone. SIGPIPE
-// is blocked in this thread while writing, and the one a failed write raises is taken
-// back (unless one was pending before), so the child's early exit cannot kill this
-// process. Returns how many bytes were written.
-size_t writeAll(int fd, std::span<const std::byte> data) {
-    sigset_t pipeSignal, oldMask, pending;
-    sigemptyset(&pipeSignal);
-    sigaddset(&pipeSignal, SIGPIPE);
-    pthread_sigmask(SIG_BLOCK, &pipeSignal, &oldMask);
-    sigemptyset(&pending);
-    sigpending(&pending);
-    const bool pendingBefore = sigismember(&pending, SIGPIPE) == 1;
-    size_t written = 0;
-    bool brokenPipe = false;
-    while (written < data.size()) {
-        const ssize_t n = write(fd, data.data() + written, data.size() - written);
-        if (n > 0) {
-            written += static_cast<size_t>(n);
-        } else if (n < 0 && errno == EINTR) {
-            continue;
-        } else {
-            brokenPipe = n < 0 && errno == EPIPE;
-            break;
-        }
+// A pipe whose ends close on exec and are not 0, 1 or 2 (were this process's standard
+// streams closed, a pipe could get their numbers, and the child's dup2 onto 0, 1 and 2
+// would mix them up).
+bool makePipe(int fds[2]) {
+    if (pipe2(fds, O_CLOEXEC) != 0) return false;
+    for (int i = 0; i < 2; ++i) {
+        if (fds[i] > 2) continue;
+        const int moved = fcntl(fds[i], F_DUPFD_CLOEXEC, 3);
+        close(fds[i]);
+        fds[i] = moved;
     }
-    if (brokenPipe && !pendingBefore) {
-        const timespec noWait{};
-        while (sigtimedwait(&pipeSignal, nullptr, &noWait) < 0 && errno == EINTR) {
-        }
+    if (fds[0] < 0 || fds[1] < 0) {
+        closeFd(fds[0]);
+        closeFd(fds[1]);
+        return false;
     }
-    pthread_sigmask(SIG_SETMASK, &oldMask, nullptr);
-    return written;
+    return true;
 }
 
-// Runs the child with standard input from `stdinFd` (in the child) or /dev/null (-1);
-// `feed`, when given, runs in this process after the child started.
-ChildResult spawnAndWait(const std::vector<std::string>& argv, int stdinFd,
-                         const std::function<void(ChildResult&)>& feed) {
-    ChildResult r;
-    if (argv.empty()) return r;
-    namespace fs = std::filesystem;
-    char tmpl[] = "/tmp/pcsg-child-XXXXXX";
-    if (!mkdtemp(tmpl)) return r;
-    const std::string dir = tmpl;
-    const std::string outPath = dir + "/out", errPath = dir + "/err";
+void setNonBlocking(int fd) {
+    const int flags = fcntl(fd, F_GETFL);
+    if (flags >= 0) fcntl(fd, F_SETFL, flags | O_NONBLOCK);
+}
 
+// Blocks SIGPIPE in this thread while it writes to a child's pipe, and takes back the one
+// a write to a closed pipe raises (unless one was pending before), so a child's early exit
+// cannot kill this process. SIGPIPE from write() goes to the writing thread, so other
+// threads (the render's) are not involved.
+class SigpipeBlock {
+public:
+    SigpipeBlock() {
+        sigemptyset(&pipeSignal_);
+        sigaddset(&pipeSignal_, SIGPIPE);
+        pthread_sigmask(SIG_BLOCK, &pipeSignal_, &oldMask_);
+        sigset_t pending;
+        sigemptyset(&pending);
+        sigpending(&pending);
+        pendingBefore_ = sigismember(&pending, SIGPIPE) == 1;
+    }
+    ~SigpipeBlock() {
+        if (raised_ && !pendingBefore_) {
+            const timespec noWait{};
+            while (sigtimedwait(&pipeSignal_, nullptr, &noWait) < 0 && errno == EINTR) {
+            }
+        }
+        pthread_sigmask(SIG_SETMASK, &oldMask_, nullptr);
+    }
+    SigpipeBlock(const SigpipeBlock&) = delete;
+    SigpipeBlock& operator=(const SigpipeBlock&) = delete;
+
+    void raised() { raised_ = true; }
+
+private:
+    sigset_t pipeSignal_, oldMask_;
+    bool pendingBefore_ = false, raised_ = false;
+};
+
+}  // namespace
+
+AsyncChild::AsyncChild(const std::vector<std::string>& argv, Input input) {
+    start_ = std::chrono::steady_clock::now();
+    if (argv.empty()) return;
+    program_ = argv[0];
+    int inPipe[2] = {-1, -1}, outPipe[2] = {-1, -1}, errPipe[2] = {-1, -1};
+    auto closeAll = [&] {
+        for (int* p : {inPipe, outPipe, errPipe}) {
+            closeFd(p[0]);
+            closeFd(p[1]);
+        }
+    };
+    if ((input == Input::Pipe && !makePipe(inPipe)) || !makePipe(outPipe) || !makePipe(errPipe)) {
+        closeAll();
+        return;
+    }
+
+    // The child's ends become its 0, 1 and 2 (dup2 clears close-on-exec on the copies);
+    // every other end closes on exec, so the child and any other child hold none of ours,
+    // and closing ours is the end of the child's input.
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    if (stdinFd >= 0)
-        posix_spawn_file_actions_adddup2(&actions, stdinFd, 0);
+    if (input == Input::Pipe)
+        posix_spawn_file_actions_adddup2(&actions, inPipe[0], 0);
     else
         posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    posix_spawn_file_actions_adddup2(&actions, outPipe[1], 1);
+    posix_spawn_file_actions_adddup2(&actions, errPipe[1], 2);
+    // The child inherits neither this thread's signal mask (which may be blocking SIGPIPE
+    // while another child is fed) nor an ignored SIGPIPE.
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    sigset_t none, pipeSignal;
+    sigemptyset(&none);
+    sigemptyset(&pipeSignal);
+    sigaddset(&pipeSignal, SIGPIPE);
+    posix_spawnattr_setsigmask(&attr, &none);
+    posix_spawnattr_setsigdefault(&attr, &pipeSignal);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
 
-    const auto start = std::chrono::steady_clock::now();
+    start_ = std::chrono::steady_clock::now();
     pid_t pid = 0;
-    const int rc = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+    const int rc = posix_spawnp(&pid, args[0], &actions, &attr, args.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
-    if (rc == 0) {
-        if (feed) feed(r);
-        int status = 0;
-        rusage usage{};
-        while (wait4(pid, &status, 0, &usage) < 0 && errno == EINTR) {
-        }
-        r.started = true;
-        r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        r.peakRssBytes = static_cast<uint64_t>(usage.ru_maxrss) * 1024;
-        if (WIFEXITED(status)) {
-            r.exitCode = WEXITSTATUS(status);
-            // posix_spawnp reports a missing program as exit 127 from the child.
-            if (r.exitCode == 127 && !inPath(argv[0]) && argv[0].find('/') == std::string::npos)
-                r.started = false;
-        } else if (WIFSIGNALED(status)) {
-            r.signal = WTERMSIG(status);
-        }
-        r.out = slurp(outPath);
-        r.err = slurp(errPath);
+    posix_spawnattr_destroy(&attr);
+    closeFd(inPipe[0]);
+    closeFd(outPipe[1]);
+    closeFd(errPipe[1]);
+    if (rc != 0) {
+        closeAll();
+        return;
     }
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-    return r;
+    started_ = true;
+    pid_ = pid;
+    in_ = inPipe[1];
+    out_ = outPipe[0];
+    err_ = errPipe[0];
+    for (int fd : {in_, out_, err_})
+        if (fd >= 0) setNonBlocking(fd);
 }
 
-}  // namespace
+AsyncChild::~AsyncChild() {
+    if (pid_ > 0) abandon();
+    closeFd(in_);
+    closeFd(out_);
+    closeFd(err_);
+}
+
+void AsyncChild::readOutput(int& fd, std::string& into) {
+    char buffer[65536];
+    const ssize_t n = read(fd, buffer, sizeof buffer);
+    if (n > 0)
+        into.append(buffer, static_cast<size_t>(n));
+    else if (n == 0 || (errno != EINTR && errno != EAGAIN))
+        closeFd(fd);  // the end of the output (or an error reading it)
+}
+
+// With `writing`: writes the rest of `data` (from `written` on) to the child's input until
+// all of it is written or the child takes no more. Without: reads the child's output to
+// its end. Either way it reads whatever output comes meanwhile, so a child blocked on a
+// full output pipe cannot block the writing. Returns whether a write hit a closed pipe.
+bool AsyncChild::pump(bool writing, std::span<const std::byte> data, size_t& written) {
+    bool brokenPipe = false;
+    for (;;) {
+        const bool wantWrite = writing && in_ >= 0 && written < data.size();
+        if (writing ? !wantWrite : (out_ < 0 && err_ < 0)) break;
+        pollfd fds[3];
+        nfds_t n = 0;
+        int inAt = -1, outAt = -1, errAt = -1;
+        if (wantWrite) {
+            inAt = static_cast<int>(n);
+            fds[n++] = {in_, POLLOUT, 0};
+        }
+        if (out_ >= 0) {
+            outAt = static_cast<int>(n);
+            fds[n++] = {out_, POLLIN, 0};
+        }
+        if (err_ >= 0) {
+            errAt = static_cast<int>(n);
+            fds[n++] = {err_, POLLIN, 0};
+        }
+        if (poll(fds, n, -1) < 0) {
+            if (errno == EINTR) continue;
+            // Only with bad descriptors, which these are not; give up rather than spin.
+            closeInput();
+            closeFd(out_);
+            closeFd(err_);
+            break;
+        }
+        if (outAt >= 0 && fds[outAt].revents != 0) readOutput(out_, result_.out);
+        if (errAt >= 0 && fds[errAt].revents != 0) readOutput(err_, result_.err);
+        if (inAt >= 0 && fds[inAt].revents != 0) {
+            const ssize_t k = write(in_, data.data() + written, data.size() - written);
+            if (k > 0) {
+                written += static_cast<size_t>(k);
+            } else if (k < 0 && (errno == EINTR || errno == EAGAIN)) {
+                continue;
+            } else {
+                // EPIPE: the child has exited or closed its input; it takes no more.
+                brokenPipe = brokenPipe || (k < 0 && errno == EPIPE);
+                closeInput();
+            }
+        }
+    }
+    return brokenPipe;
+}
+
+size_t AsyncChild::feed(std::span<const std::byte> data) {
+    if (in_ < 0 || data.empty()) return 0;
+    SigpipeBlock block;
+    size_t written = 0;
+    if (pump(true, data, written)) block.raised();
+    result_.inputWritten += written;
+    return written;
+}
+
+void AsyncChild::closeInput() {
+    closeFd(in_);
+}
+
+ChildResult AsyncChild::wait() {
+    closeInput();
+    size_t none = 0;
+    pump(false, {}, none);
+    return reap(true);
+}
+
+ChildResult AsyncChild::abandon() {
+    closeInput();
+    closeFd(out_);
+    closeFd(err_);
+    // The child is not reaped yet, so its pid is still its own (a zombie's at worst, which
+    // the signal does not harm).
+    if (pid_ > 0) kill(pid_, SIGKILL);
+    return reap(false);
+}
+
+ChildResult AsyncChild::reap(bool keepOutput) {
+    if (pid_ <= 0) return result_;  // never started, or reaped already
+    int status = 0;
+    rusage usage{};
+    pid_t got;
+    while ((got = wait4(pid_, &status, 0, &usage)) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+    result_.started = true;
+    result_.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (!keepOutput) {
+        result_.out.clear();
+        result_.err.clear();
+    }
+    if (got < 0) return result_;  // someone else reaped it (SIGCHLD ignored): status unknown
+    result_.peakRssBytes = static_cast<uint64_t>(usage.ru_maxrss) * 1024;
+    if (WIFEXITED(status)) {
+        result_.exitCode = WEXITSTATUS(status);
+        // An old posix_spawnp reports a missing program as exit 127 from the child.
+        if (result_.exitCode == 127 && program_.find('/') == std::string::npos &&
+            !inPath(program_))
+            result_.started = false;
+    } else if (WIFSIGNALED(status)) {
+        result_.signal = WTERMSIG(status);
+    }
+    return result_;
+}
 
 ChildResult runChild(const std::vector<std::string>& argv) {
-    return spawnAndWait(argv, -1, {});
+    AsyncChild child(argv, AsyncChild::Input::DevNull);
+    return child.wait();
 }
 
 ChildResult runChild(const std::vector<std::string>& argv, std::span<const std::byte> input) {
-    // Both ends close on exec: the child gets the read end as its standard input (dup2
-    // clears the flag on the copy), and neither it nor any other child holds the write
-    // end, so closing ours is the end of its input.
-    int fds[2];
-    if (pipe2(fds, O_CLOEXEC) != 0) return ChildResult{};
-    ChildResult r = spawnAndWait(argv, fds[0], [&](ChildResult& result) {
-        close(fds[0]);
-        fds[0] = -1;
-        result.inputWritten = writeAll(fds[1], input);
-        close(fds[1]);
-        fds[1] = -1;
-    });
-    for (int fd : fds)
-        if (fd >= 0) close(fd);
-    return r;
+    AsyncChild child(argv);
+    child.feed(input);
+    return child.wait();
 }
 
 std::string selfExecutable() {
