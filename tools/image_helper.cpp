@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -46,13 +47,17 @@ std::string missingImageHelperMessage() {
         kImageHelperName, self.string(), kImageHelperName);
 }
 
-ImageWriteResult writeImageWithHelper(const std::string& helper, const std::string& path, int width,
-                                      int height, std::span<const float> rgb) {
+ImageWriter::ImageWriter(const std::string& helper, const std::string& path, int width, int height)
+    : child_({helper, "write", path, std::to_string(width), std::to_string(height)}) {}
+
+ImageWriteResult ImageWriter::finish(std::span<const float> rgb) {
     ImageWriteResult w;
-    const ChildResult c = runChild(
-        {helper, "write", path, std::to_string(width), std::to_string(height)}, std::as_bytes(rgb));
+    const auto begin = std::chrono::steady_clock::now();
+    child_.feed(std::as_bytes(rgb));
+    const ChildResult c = child_.wait();
+    w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+    w.helperSeconds = c.seconds;
     w.peakRssBytes = c.peakRssBytes;
-    w.seconds = c.seconds;
     w.ok = c.started && c.exitCode == 0;
     if (w.ok && c.inputWritten != rgb.size_bytes()) {
         // Cannot happen with pcsg-image (it reads everything or fails), but a helper that
@@ -64,6 +69,15 @@ ImageWriteResult writeImageWithHelper(const std::string& helper, const std::stri
         w.error = helperError(c);
     }
     return w;
+}
+
+void ImageWriter::abandon() {
+    child_.abandon();
+}
+
+ImageWriteResult writeImageWithHelper(const std::string& helper, const std::string& path, int width,
+                                      int height, std::span<const float> rgb) {
+    return ImageWriter(helper, path, width, height).finish(rgb);
 }
 
 ImageCompareRun compareImagesWithHelper(const std::string& helper, const std::string& a,

@@ -29,11 +29,36 @@ struct ImageWriteResult {
     bool ok = false;
     std::string error;          // why not, as the helper said it (one or more lines)
     uint64_t peakRssBytes = 0;  // the helper process's
-    double seconds = 0;         // wall time of the helper, piping included
+    // Wall time from the first byte of the pixels to the helper's exit: what the caller
+    // waited for once it had the pixels (the piping, the encoding, and whatever of the
+    // helper's start-up was still going on).
+    double seconds = 0;
+    double helperSeconds = 0;  // the helper's whole wall time, from its start
+};
+
+// `pcsg-image write PATH WIDTH HEIGHT`, started before the pixels exist so that its
+// start-up (loading OpenImageIO's shared libraries, about half a second) overlaps the
+// work that makes them; it then waits on its standard input. Either finish() gives it
+// the pixels, or abandon() (or the destructor) stops it.
+class ImageWriter {
+public:
+    ImageWriter(const std::string& helper, const std::string& path, int width, int height);
+
+    // Pipes the pixels (linear RGB floats, row-major from the top-left) to the helper and
+    // waits for it to write the file.
+    ImageWriteResult finish(std::span<const float> rgb);
+
+    // No image after all: the helper, which cannot have written anything without its
+    // input, is killed and reaped, and what it said is dropped (so its complaint about a
+    // truncated input never reaches the user).
+    void abandon();
+
+private:
+    AsyncChild child_;
 };
 
 // `pcsg-image write PATH WIDTH HEIGHT` with the pixels (linear RGB floats, row-major from
-// the top-left) on its standard input.
+// the top-left) on its standard input: ImageWriter's start and finish() at once.
 ImageWriteResult writeImageWithHelper(const std::string& helper, const std::string& path, int width,
                                       int height, std::span<const float> rgb);
 

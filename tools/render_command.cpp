@@ -140,7 +140,7 @@ int runRender(const RenderCommandOptions& o) {
         co.maxVisits = o.countVisits;
         count = countExpansion(g, co);
     } catch (const RuntimeError& e) {
-        std::cerr << writer.finish({}).error << "\n";  // MUTATION
+        writer.abandon();
         std::cerr << e.format(g) << "\n";
         return 1;
     }

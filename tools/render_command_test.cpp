@@ -1,10 +1,17 @@
 // `pcsg render` run as a program: it renders in its own process and has pcsg-image write
 // the file, so the image must come out whole (size, and the same pixels whichever format
 // carries them), a scene with a run-time error must leave no image, and a missing
-// helper must be named.
+// helper must be named. The helper starts before the render (its start-up overlaps it):
+// a scene that does not compile starts none, one that fails at run time stops it without
+// a word from it, and no exit leaves a helper process behind.
 #include <gtest/gtest.h>
+#include <sys/inotify.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -38,6 +45,79 @@ S if(c > 0, 2, 1)
                   move(-0.5,0.5,-0.5) uscale(0.5) S )
 )";
 
+// While it lives, descendants of this test process that lose their parent are re-parented
+// to it instead of init: a pcsg-image that pcsg left running or unreaped turns up here.
+class Subreaper {
+public:
+    Subreaper() { prctl(PR_SET_CHILD_SUBREAPER, 1); }
+    ~Subreaper() {
+        leftovers();
+        prctl(PR_SET_CHILD_SUBREAPER, 0);
+    }
+    Subreaper(const Subreaper&) = delete;
+    Subreaper& operator=(const Subreaper&) = delete;
+
+    // How many processes were left behind (now reaped). One still running is waited for:
+    // with pcsg gone, its input is at an end.
+    int leftovers() {
+        int found = 0, status = 0;
+        for (;;) {
+            const pid_t p = waitpid(-1, &status, 0);
+            if (p > 0) {
+                ++found;
+            } else if (errno != EINTR) {
+                return found;  // ECHILD: none left
+            }
+        }
+    }
+};
+
+// The number of times `what` occurs in `text`.
+size_t occurrences(const std::string& text, const std::string& what) {
+    size_t n = 0;
+    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+// A copy of pcsg alone in a directory with a stand-in pcsg-image beside it: a shell script
+// that does `script` and then, if it gets that far, runs the real helper. An inotify watch
+// on the script sees every start of it (exec opens the file), however soon it is killed.
+class HelperBeside {
+public:
+    HelperBeside(const TempDir& dir, const std::string& script) : dir_(dir) {
+        namespace fs = std::filesystem;
+        fs::copy_file(PCSG_EXECUTABLE, dir.file("pcsg"));
+        dir.write("pcsg-image", "#!/bin/sh\n" + script + "\nexec '" +
+                                    std::string(PCSG_IMAGE_EXECUTABLE) + "' \"$@\"\n");
+        for (const char* name : {"pcsg", "pcsg-image"})
+            fs::permissions(dir.file(name), fs::perms::owner_exec, fs::perm_options::add);
+        watch_ = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+        EXPECT_GE(watch_, 0);
+        EXPECT_GE(inotify_add_watch(watch_, dir.file("pcsg-image").c_str(), IN_OPEN), 0);
+    }
+    ~HelperBeside() {
+        if (watch_ >= 0) close(watch_);
+    }
+    HelperBeside(const HelperBeside&) = delete;
+    HelperBeside& operator=(const HelperBeside&) = delete;
+
+    ChildResult pcsg(std::vector<std::string> args) const {
+        args.insert(args.begin(), dir_.file("pcsg"));
+        return runChild(args);
+    }
+    // Whether the helper was started since the last call.
+    bool started() const {
+        bool any = false;
+        alignas(inotify_event) char events[4096];
+        while (read(watch_, events, sizeof events) > 0) any = true;
+        return any;
+    }
+
+private:
+    const TempDir& dir_;
+    int watch_ = -1;
+};
+
 template <class T>
 std::vector<T> readBack(const std::string& path, OIIO::TypeDesc type, OIIO::ImageSpec& spec) {
     auto in = OIIO::ImageInput::open(path);
@@ -52,6 +132,7 @@ std::vector<T> readBack(const std::string& path, OIIO::TypeDesc type, OIIO::Imag
 }
 
 TEST(RenderCommand, WritesAPngOfTheRightSize) {
+    Subreaper subreaper;
     TempDir dir;
     const std::string scene = dir.write("s.pcsg", kScene);
     const std::string out = dir.file("s.png");
@@ -71,7 +152,10 @@ TEST(RenderCommand, WritesAPngOfTheRightSize) {
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_GT(j.value("peak_rss_bytes", uint64_t{0}), 0u);
     EXPECT_GT(j.value("image_writer_peak_rss_bytes", uint64_t{0}), 0u);
+    EXPECT_TRUE(j.contains("image_write_seconds"));
+    EXPECT_TRUE(j.contains("image_writer_seconds"));
     EXPECT_EQ(filesIn(dir.path()), (std::vector<std::string>{"s.pcsg", "s.png"}));
+    EXPECT_EQ(subreaper.leftovers(), 0);
 }
 
 TEST(RenderCommand, PngAndExrCarryTheSamePixels) {
@@ -94,21 +178,89 @@ TEST(RenderCommand, PngAndExrCarryTheSamePixels) {
         ASSERT_EQ(png[i], std::lround(srgbEncode(exr[i]) * 255.0)) << "value " << i;
 }
 
+// The selection returns 3, and S has two rules.
+const char* kRunTimeError =
+    "{c=2} S\n"
+    "S if(c > 0, 3, 1)\n"
+    "1: S -> sphere\n"
+    "2: S -> {c=c-1} uscale(0.5) S\n";
+
 TEST(RenderCommand, ARunTimeErrorExitsOneAndWritesNothing) {
+    // Found by the primitive count before the render, and (the count stopped at once) by
+    // the render itself: either way the writer, started before both, is stopped silently.
+    for (const char* countVisits : {"20000000", "0"}) {
+        SCOPED_TRACE(std::string("--count-visits ") + countVisits);
+        Subreaper subreaper;
+        TempDir dir;
+        const std::string scene = dir.write("bad.pcsg", kRunTimeError);
+        const std::string out = dir.file("bad.png");
+        const ChildResult r = pcsg({"render", scene, "-o", out, "--width", "16", "--height", "12",
+                                    "--count-visits", countVisits});
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_EQ(r.signal, 0);
+        // Exactly the one error, with its module path; nothing from pcsg-image (whose
+        // input ended unwritten).
+        EXPECT_EQ(occurrences(r.err, "error"), 1u) << r.err;
+        EXPECT_EQ(r.err.rfind(scene + ":2:3: error: the selection function of module S", 0), 0u)
+            << r.err;
+        EXPECT_EQ(r.err.find("pcsg-image"), std::string::npos) << r.err;
+        EXPECT_EQ(r.out, "");
+        EXPECT_FALSE(std::filesystem::exists(out));
+        EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"bad.pcsg"});
+        EXPECT_EQ(subreaper.leftovers(), 0);
+    }
+}
+
+TEST(RenderCommand, ARunTimeErrorSilencesAWriterThatComplained) {
+    // This writer complains before it even reads its input; the user must not see it.
+    Subreaper subreaper;
     TempDir dir;
-    // The selection returns 3, and S has two rules.
-    const std::string scene = dir.write("bad.pcsg",
-                                        "{c=2} S\n"
-                                        "S if(c > 0, 3, 1)\n"
-                                        "1: S -> sphere\n"
-                                        "2: S -> {c=c-1} uscale(0.5) S\n");
-    const std::string out = dir.file("bad.png");
-    const ChildResult r = pcsg({"render", scene, "-o", out, "--width", "16", "--height", "12"});
+    HelperBeside helper(dir, "echo 'pcsg-image write: a complaint' >&2");
+    const std::string scene = dir.write("bad.pcsg", kRunTimeError);
+    const ChildResult r =
+        helper.pcsg({"render", scene, "-o", dir.file("bad.png"), "--width", "16", "--height", "12"});
     EXPECT_EQ(r.exitCode, 1) << r.err;
-    EXPECT_NE(r.err.find("error"), std::string::npos) << r.err;
+    EXPECT_TRUE(helper.started());  // before the render: it was there to be stopped
+    EXPECT_EQ(occurrences(r.err, "error"), 1u) << r.err;
+    EXPECT_EQ(r.err.find("complaint"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.png")));
+    EXPECT_EQ(subreaper.leftovers(), 0);
+}
+
+TEST(RenderCommand, ACompileErrorStartsNoWriter) {
+    Subreaper subreaper;
+    TempDir dir;
+    HelperBeside helper(dir, "");
+    const ChildResult bad = helper.pcsg(
+        {"render", dir.write("bad.pcsg", "sphere ∪\n"), "-o", dir.file("bad.png")});
+    EXPECT_EQ(bad.exitCode, 1) << bad.err;
+    EXPECT_NE(bad.err.find("error"), std::string::npos) << bad.err;
+    EXPECT_FALSE(helper.started());
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.png")));
+    // The watch does see a start: a scene that compiles runs the helper.
+    const ChildResult good = helper.pcsg({"render", dir.write("s.pcsg", kScene), "-o",
+                                          dir.file("s.png"), "--width", "16", "--height", "12"});
+    EXPECT_EQ(good.exitCode, 0) << good.err;
+    EXPECT_TRUE(helper.started());
+    EXPECT_TRUE(std::filesystem::exists(dir.file("s.png")));
+    EXPECT_EQ(subreaper.leftovers(), 0);
+}
+
+TEST(RenderCommand, AWriterThatDiesBeforeReadingIsAnError) {
+    // The writer is gone long before the pixels are ready: writing them must fail with
+    // EPIPE, not kill pcsg with SIGPIPE, and what the writer said is the error.
+    Subreaper subreaper;
+    TempDir dir;
+    HelperBeside helper(dir, "echo 'pcsg-image: out of order' >&2; exit 3");
+    const std::string out = dir.file("s.png");
+    const ChildResult r = helper.pcsg(
+        {"render", dir.write("s.pcsg", kScene), "-o", out, "--width", "16", "--height", "12"});
+    EXPECT_EQ(r.signal, 0);
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_EQ(r.err, "pcsg render: pcsg-image: out of order\n");
     EXPECT_EQ(r.out, "");
     EXPECT_FALSE(std::filesystem::exists(out));
-    EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"bad.pcsg"});
+    EXPECT_EQ(subreaper.leftovers(), 0);
 }
 
 TEST(RenderCommand, AMissingImageHelperIsNamed) {
@@ -129,13 +281,19 @@ TEST(RenderCommand, AMissingImageHelperIsNamed) {
 }
 
 TEST(RenderCommand, AnUnwritableOutputIsAnError) {
+    Subreaper subreaper;
     TempDir dir;
     const std::string scene = dir.write("s.pcsg", kScene);
     const std::string out = dir.file("missing/s.png");
     const ChildResult r = pcsg({"render", scene, "-o", out, "--width", "16", "--height", "12"});
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_NE(r.err.find("cannot write '" + out + "'"), std::string::npos) << r.err;
+    // One line, the writer's reason under pcsg render's name.
+    EXPECT_EQ(r.err.rfind("pcsg render: pcsg-image write: cannot write '" + out + "': ", 0), 0u)
+        << r.err;
+    EXPECT_EQ(occurrences(r.err, "\n"), 1u) << r.err;
+    EXPECT_EQ(r.out, "");
     EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"s.pcsg"});
+    EXPECT_EQ(subreaper.leftovers(), 0);
 }
 
 }  // namespace
