@@ -262,8 +262,7 @@ ChildResult AsyncChild::reap(bool keepOutput) {
     if (WIFEXITED(status)) {
         result_.exitCode = WEXITSTATUS(status);
         // An old posix_spawnp reports a missing program as exit 127 from the child.
-        if (result_.exitCode == 127 && program_.find('/') == std::string::npos &&
-            !inPath(program_))
+        if (result_.exitCode == 127 && program_.find('/') == std::string::npos && !inPath(program_))
             result_.started = false;
     } else if (WIFSIGNALED(status)) {
         result_.signal = WTERMSIG(status);

@@ -217,8 +217,8 @@ TEST(RenderCommand, ARunTimeErrorSilencesAWriterThatComplained) {
     TempDir dir;
     HelperBeside helper(dir, "echo 'pcsg-image write: a complaint' >&2");
     const std::string scene = dir.write("bad.pcsg", kRunTimeError);
-    const ChildResult r =
-        helper.pcsg({"render", scene, "-o", dir.file("bad.png"), "--width", "16", "--height", "12"});
+    const ChildResult r = helper.pcsg(
+        {"render", scene, "-o", dir.file("bad.png"), "--width", "16", "--height", "12"});
     EXPECT_EQ(r.exitCode, 1) << r.err;
     EXPECT_TRUE(helper.started());  // before the render: it was there to be stopped
     EXPECT_EQ(occurrences(r.err, "error"), 1u) << r.err;
@@ -231,8 +231,8 @@ TEST(RenderCommand, ACompileErrorStartsNoWriter) {
     Subreaper subreaper;
     TempDir dir;
     HelperBeside helper(dir, "");
-    const ChildResult bad = helper.pcsg(
-        {"render", dir.write("bad.pcsg", "sphere ∪\n"), "-o", dir.file("bad.png")});
+    const ChildResult bad =
+        helper.pcsg({"render", dir.write("bad.pcsg", "sphere ∪\n"), "-o", dir.file("bad.png")});
     EXPECT_EQ(bad.exitCode, 1) << bad.err;
     EXPECT_NE(bad.err.find("error"), std::string::npos) << bad.err;
     EXPECT_FALSE(helper.started());
