@@ -140,10 +140,10 @@ class ExpansionCache {
         uint64_t built = 0, used = 0;
         bool off = false;
     };
-    std::vector<Yield> yield_;
-    uint32_t levels_;
     const TraceScene& scene_;
     size_t maxBytes_;
+    std::vector<Yield> yield_;
+    uint32_t levels_;
     size_t bytes_ = 0;
     uint64_t expansions_ = 0;
     std::list<Entry> lru_;  // most recently used first
