@@ -1,0 +1,59 @@
+// pcsg bench: the table it prints and appends, its JSON, and its verdicts on the targets.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_test_util.h"
+
+namespace pcsg::tools {
+namespace {
+
+using testing::pcsg;
+using testing::readFile;
+using testing::TempDir;
+
+TEST(BenchCommand, NativeOnlyJsonHasTheFiguresOfEachScene) {
+    TempDir dir;
+    const std::string a = dir.write("sierpinski_8.pcsg", testing::kSierpinskiA);
+    const ChildResult r =
+        pcsg({"bench", "--native-only", "--json", "--width", "32", "--height", "24", a});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(j.contains("scenes")) << r.out;
+    ASSERT_EQ(j["scenes"].size(), 1u);
+    const auto& s = j["scenes"][0];
+    EXPECT_EQ(s["scene"], "sierpinski_8");
+    EXPECT_TRUE(s["native_ok"].get<bool>());
+    EXPECT_GT(s["native_seconds"].get<double>(), 0);
+    EXPECT_GT(s["native_peak_rss_bytes"].get<uint64_t>(), 0u);
+    EXPECT_EQ(s["primitive_equivalence"].get<uint64_t>(), 4096u);  // order 6
+    EXPECT_FALSE(s["povray_ok"].get<bool>());
+}
+
+TEST(BenchCommand, SideBySideTableWithDateMachineAndTargets) {
+    if (!inPath("povray")) GTEST_SKIP() << "povray is not installed";
+    TempDir dir;
+    // Named like the order-8 scene of the targets, so that the verdicts are printed.
+    const std::string a = dir.write("sierpinski_8.pcsg", testing::kSierpinskiA);
+    const std::string md = dir.file("bench.md");
+    const ChildResult r = pcsg({"bench", "--width", "48", "--height", "36", "--markdown", md, a});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string table = readFile(md);
+    EXPECT_EQ(table, "\n" + r.out) << "the file gets what is printed";
+    EXPECT_NE(table.find("Benchmark of 20"), std::string::npos) << table;
+    EXPECT_NE(table.find(" cores"), std::string::npos) << table;
+    EXPECT_NE(table.find("| sierpinski_8 | 4096 |"), std::string::npos) << table;
+    EXPECT_NE(table.find("order 8 at least 3x faster than POV-Ray"), std::string::npos) << table;
+    EXPECT_NE(table.find("order 8 peak RSS at most 1/20"), std::string::npos) << table;
+    // Appending keeps what was there.
+    ASSERT_EQ(pcsg({"bench", "--width", "48", "--height", "36", "--markdown", md, a}).exitCode, 0);
+    EXPECT_EQ(readFile(md).substr(0, table.size()), table);
+}
+
+TEST(BenchCommand, AMissingSceneFailsTheBench) {
+    const ChildResult r = pcsg({"bench", "--native-only", "/nonexistent/scene.pcsg"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("scene.pcsg"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace pcsg::tools
