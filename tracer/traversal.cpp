@@ -141,7 +141,7 @@ Tracer::Tracer(const TraceScene& scene)
 Tracer::~Tracer() = default;
 
 // The expanded instance to trace instead of walking below S-node n, if there is one.
-const ExpandedInstance* Tracer::expanded(NodeId n, const Ctx& c, uint32_t depth) {
+const ExpandedInstance* Tracer::expandedAt(NodeId n, const Ctx& c, uint32_t depth) {
     if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->expandAt(n, depth))
         return nullptr;
     const ExpandedInstance* x = expansion_->get(n, depth, c.frame, c.path);
@@ -205,9 +205,16 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
     return walk(origin, dir, tmin, tmax, hit);
 }
 
-bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
-                   Hit& hit) {
-    ++visits_;
+// The unary nodes on the way down, shared by first() and spans(): an S-node selects its
+// rule (or is culled by its boxes, or hands the ray to an expanded instance), a C-node
+// computes a new frame, a T-node maps the ray into its child's frame, paint sets the
+// material. `below(node, ray, ctx)` walks on from the node they lead to; `expanded(x,
+// ctx)` traces an expanded instance instead; `transformBack(inv, walkBelow)` runs the
+// walk below a T-node and brings the normals it found back through the T-node.
+template <class Below, class Expanded, class TransformBack>
+auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax,
+                   Below below, Expanded expanded, TransformBack transformBack) {
+    using Result = decltype(below(n, r, c));
     const Node& node = g_.nodes[n];
     switch (node.kind) {
         case NodeKind::Select: {
@@ -216,13 +223,10 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
             try {
                 checkDepth(g_, n, depth, st);
                 checkStack();
-                if (selectCulled(n, r, c, depth, tmin, tmax)) return false;
-                if (const ExpandedInstance* x = expanded(n, c, depth))
-                    return x->first(r, tmin, tmax, hit, {c.path, c.material}, anyHit_,
-                                    expansion_->scratch());
+                if (selectCulled(n, r, c, depth, tmin, tmax)) return Result{};
+                if (const ExpandedInstance* x = expandedAt(n, c, depth)) return expanded(*x, c);
                 const uint32_t rule = selectRule(g_, n, st);
-                const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
-                return first(g_.child(n, rule), r, cc, tmin, tmax, hit);
+                return below(g_.child(n, rule), r, Ctx{c.frame, pathRule(c.path, rule), depth, c.material});
             } catch (RuntimeError& e) {
                 e.enterModule(g_.modules[node.payload].name);
                 throw;
@@ -231,8 +235,7 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
         case NodeKind::Calc: {
             double* f = frames_.push();
             applyCalc(g_, n, EvalState{c.frame, c.path}, f);
-            const bool found =
-                first(g_.child(n), r, Ctx{f, c.path, c.depth, c.material}, tmin, tmax, hit);
+            const Result found = below(g_.child(n), r, Ctx{f, c.path, c.depth, c.material});
             frames_.pop();
             return found;
         }
@@ -246,13 +249,37 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 target = g_.child(n);
             }
             const LocalRay rr{inv->point(r.o), inv->vector(r.d)};
-            if (!first(target, rr, c, tmin, tmax, hit)) return false;
-            hit.normal = inv->transposedVector(hit.normal);
-            return true;
+            return transformBack(*inv, [&] { return below(target, rr, c); });
         }
         case NodeKind::Paint:
-            return first(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload}, tmin, tmax,
-                         hit);
+            return below(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload});
+        default: return Result{};  // not a unary node
+    }
+}
+
+bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
+                   Hit& hit) {
+    ++visits_;
+    const Node& node = g_.nodes[n];
+    switch (node.kind) {
+        case NodeKind::Select:
+        case NodeKind::Calc:
+        case NodeKind::Transform:
+        case NodeKind::Paint:
+            return unary(
+                n, r, c, tmin, tmax,
+                [&](NodeId below, const LocalRay& rr, const Ctx& cc) {
+                    return first(below, rr, cc, tmin, tmax, hit);
+                },
+                [&](const ExpandedInstance& x, const Ctx& cc) {
+                    return x.first(r, tmin, tmax, hit, {cc.path, cc.material}, anyHit_,
+                                   expansion_->scratch());
+                },
+                [&](const Affine& inv, auto&& walkBelow) {
+                    if (!walkBelow()) return false;
+                    hit.normal = inv.transposedVector(hit.normal);
+                    return true;
+                });
         case NodeKind::Union:
             return firstOfUnion(
                 node.childCount, tmin, tmax, hit, anyHit_, order_,
@@ -313,52 +340,28 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
     ++visits_;
     const Node& node = g_.nodes[n];
     switch (node.kind) {
-        case NodeKind::Select: {
-            const uint32_t depth = c.depth + 1;
-            const EvalState st{c.frame, c.path};
-            try {
-                checkDepth(g_, n, depth, st);
-                checkStack();
-                if (selectCulled(n, r, c, depth, tmin, tmax)) return 0;
-                if (const ExpandedInstance* x = expanded(n, c, depth))
-                    return x->spans(r, tmin, tmax, spans_, {c.path, c.material},
-                                    expansion_->scratch());
-                const uint32_t rule = selectRule(g_, n, st);
-                const Ctx cc{c.frame, pathRule(c.path, rule), depth, c.material};
-                return spans(g_.child(n, rule), r, cc, tmin, tmax);
-            } catch (RuntimeError& e) {
-                e.enterModule(g_.modules[node.payload].name);
-                throw;
-            }
-        }
-        case NodeKind::Calc: {
-            double* f = frames_.push();
-            applyCalc(g_, n, EvalState{c.frame, c.path}, f);
-            const size_t count =
-                spans(g_.child(n), r, Ctx{f, c.path, c.depth, c.material}, tmin, tmax);
-            frames_.pop();
-            return count;
-        }
-        case NodeKind::Transform: {
-            NodeId target = scene_.target_[n];
-            Affine computed;
-            const Affine* inv = &scene_.inverse_[n];
-            if (target == kNone) {
-                computed = transformMatrix(g_, n, EvalState{c.frame, c.path}).inverse();
-                inv = &computed;
-                target = g_.child(n);
-            }
-            const LocalRay rr{inv->point(r.o), inv->vector(r.d)};
-            const size_t base = spans_.size();
-            const size_t count = spans(target, rr, c, tmin, tmax);
-            for (size_t k = base; k < base + count; ++k) {
-                spans_[k].in.normal = inv->transposedVector(spans_[k].in.normal);
-                spans_[k].out.normal = inv->transposedVector(spans_[k].out.normal);
-            }
-            return count;
-        }
+        case NodeKind::Select:
+        case NodeKind::Calc:
+        case NodeKind::Transform:
         case NodeKind::Paint:
-            return spans(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload}, tmin, tmax);
+            return unary(
+                n, r, c, tmin, tmax,
+                [&](NodeId below, const LocalRay& rr, const Ctx& cc) {
+                    return spans(below, rr, cc, tmin, tmax);
+                },
+                [&](const ExpandedInstance& x, const Ctx& cc) {
+                    return x.spans(r, tmin, tmax, spans_, {cc.path, cc.material},
+                                   expansion_->scratch());
+                },
+                [&](const Affine& inv, auto&& walkBelow) {
+                    const size_t base = spans_.size();
+                    const size_t count = walkBelow();
+                    for (size_t k = base; k < base + count; ++k) {
+                        spans_[k].in.normal = inv.transposedVector(spans_[k].in.normal);
+                        spans_[k].out.normal = inv.transposedVector(spans_[k].out.normal);
+                    }
+                    return count;
+                });
         case NodeKind::Union:
         case NodeKind::Intersection:
         case NodeKind::Difference:

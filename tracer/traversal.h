@@ -151,7 +151,10 @@ class Tracer {
     size_t spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax);
     bool selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
                       double tmax);
-    const ExpandedInstance* expanded(NodeId n, const Ctx& c, uint32_t depth);
+    const ExpandedInstance* expandedAt(NodeId n, const Ctx& c, uint32_t depth);
+    template <class Below, class Expanded, class TransformBack>
+    auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax,
+               Below below, Expanded expanded, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
     void checkStack();
 
