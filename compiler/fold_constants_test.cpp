@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "compile_test_util.h"
 #include "compiler.h"
 #include "eval.h"
 #include "walk.h"
@@ -14,17 +15,9 @@
 namespace pcsg {
 namespace {
 
-struct Compiled {
-    std::string text;
-    Diagnostics diags;
-    std::optional<Graph> graph;
-};
-
-std::unique_ptr<Compiled> compile(std::string text, bool fold = true) {
-    auto c = std::make_unique<Compiled>();
-    c->text = std::move(text);
-    c->graph = compileSource("t.pcsg", c->text, c->diags, CompileOptions{.foldConstants = fold});
-    if (!c->graph) ADD_FAILURE() << c->diags.format();
+std::unique_ptr<testing::Compiled> compile(std::string text, bool fold = true) {
+    auto c = testing::compile(std::move(text), CompileOptions{.foldConstants = fold});
+    if (!c->graph) ADD_FAILURE() << c->errors();
     return c;
 }
 

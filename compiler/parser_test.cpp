@@ -8,25 +8,16 @@
 #include <memory>
 #include <string>
 
+#include "compile_test_util.h"
 #include "compiler.h"
 #include "eval.h"
 
 namespace pcsg {
 namespace {
 
-struct Compiled {
-    std::string text;
-    Diagnostics diags;
-    std::optional<Graph> graph;
-    std::string errors() const { return diags.format(); }
-};
-
-std::unique_ptr<Compiled> compile(std::string text) {
-    auto c = std::make_unique<Compiled>();
-    c->text = std::move(text);
-    // The graph as the builder makes it: fold_constants_test.cpp tests the folding.
-    c->graph = compileSource("t.pcsg", c->text, c->diags, CompileOptions{.foldConstants = false});
-    return c;
+// The graph as the builder makes it: fold_constants_test.cpp tests the folding.
+std::unique_ptr<testing::Compiled> compile(std::string text) {
+    return testing::compileUnfolded(std::move(text));
 }
 
 // A compact picture of the graph below a node: U(..) I(..) D(..) for the operators,

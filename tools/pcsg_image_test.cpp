@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_test_util.h"
+#include "image_test_util.h"
 
 namespace pcsg::tools {
 namespace {
@@ -21,6 +22,7 @@ namespace {
 using testing::filesIn;
 using testing::pcsgImage;
 using testing::TempDir;
+using testing::readBack;
 
 // A 3x2 image whose values cover the cases: black, white, mid-grey, clamping above 1 and
 // below 0, the linear segment of sRGB near 0.
@@ -38,20 +40,6 @@ const std::vector<int> k16Bit = {0,     48192, 65535, 31754, 65535, 0, 847,   16
 
 std::span<const std::byte> bytesOf(const std::vector<float>& v) {
     return std::as_bytes(std::span(v));
-}
-
-// Reads every channel of an image file in the given type.
-template <class T>
-std::vector<T> readBack(const std::string& path, OIIO::TypeDesc type, OIIO::ImageSpec& spec) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) {
-        ADD_FAILURE() << "cannot open " << path << ": " << OIIO::geterror();
-        return {};
-    }
-    spec = in->spec();
-    std::vector<T> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
-    EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, type, pixels.data())) << in->geterror();
-    return pixels;
 }
 
 TEST(PcsgImageWrite, PngIsEightBitSrgb) {

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_test_util.h"
+#include "image_test_util.h"
 #include "image_format.h"
 
 namespace pcsg::tools {
@@ -30,6 +31,7 @@ namespace {
 using testing::filesIn;
 using testing::pcsg;
 using testing::TempDir;
+using testing::readBack;
 
 // Figure 3a with a camera and a light, small enough to render in a moment.
 const char* kScene =
@@ -117,19 +119,6 @@ private:
     const TempDir& dir_;
     int watch_ = -1;
 };
-
-template <class T>
-std::vector<T> readBack(const std::string& path, OIIO::TypeDesc type, OIIO::ImageSpec& spec) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) {
-        ADD_FAILURE() << "cannot open " << path << ": " << OIIO::geterror();
-        return {};
-    }
-    spec = in->spec();
-    std::vector<T> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
-    EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, type, pixels.data())) << in->geterror();
-    return pixels;
-}
 
 TEST(RenderCommand, WritesAPngOfTheRightSize) {
     Subreaper subreaper;
