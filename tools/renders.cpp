@@ -83,6 +83,7 @@ RenderRun renderPovray(const std::string& pov, const std::string& out, int width
     r.ok = r.child.exitCode == 0 && std::filesystem::exists(out);
     if (!r.ok) r.error = "POV-Ray could not render " + pov + ":\n" + firstLines(r.child.err, 20);
     r.parseSeconds = povrayTime(r.child.err, "Parse");
+    r.traceSeconds = povrayTime(r.child.err, "Trace");
     return r;
 }
 

@@ -18,6 +18,7 @@ struct RenderRun {
     std::string error;                  // why it failed, with the start of its stderr
     std::optional<nlohmann::json> json; // what `pcsg ... --json` printed
     std::optional<double> parseSeconds; // POV-Ray's own parse time
+    std::optional<double> traceSeconds; // POV-Ray's own trace time
 };
 
 // `pcsg render SCENE -o OUT --width W --height H --json [extra...]`.

@@ -68,14 +68,6 @@ struct SceneResult {
     std::string source;  // the scene's text, for the report
 };
 
-// POV-Ray prints "Trace Time:    0 hours  0 minutes  1 seconds (1.234 seconds)".
-std::optional<double> povrayTraceSeconds(const std::string& err) {
-    static const std::regex re(R"(Trace\s*Time:.*\(([0-9.]+) seconds\))");
-    std::smatch m;
-    if (std::regex_search(err, m, re)) return std::stod(m[1]);
-    return std::nullopt;
-}
-
 // The scene's text for the report (up to 256 KB); empty when it cannot be read.
 std::string readSource(const std::string& scene) {
     std::ifstream in(scene, std::ios::binary);
@@ -163,7 +155,7 @@ SceneResult verifyScene(const std::string& scene, const std::string& dir, const 
     r.povray.seconds = povray.child.seconds;
     r.povray.peakRssBytes = povray.child.peakRssBytes;
     r.povray.parseSeconds = povray.parseSeconds;
-    r.povray.traceSeconds = povrayTraceSeconds(povray.child.err);
+    r.povray.traceSeconds = povray.traceSeconds;
 
     // 4. The same box filter on both, then the comparison (pcsg-image compare), which also
     // writes the reduced images and the heat map for the report.
