@@ -56,7 +56,7 @@ struct InstanceBoxOptions {
     // Depths whose instances all took between these many visits to unroll are worth
     // expanding (expanded_instances.h).
     uint64_t minExpandWeight = 12;
-    uint64_t maxExpandWeight = 1024;
+    uint64_t maxExpandWeight = 8192;
 };
 
 struct InstanceBoxStats {
