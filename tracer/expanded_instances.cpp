@@ -1,6 +1,7 @@
 // Expanded instances: see expanded_instances.h.
 #include "expanded_instances.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -36,7 +37,10 @@ class ExpansionBuilder {
         base_ = depth;
         out_.root_ = build(g_.child(select, rule), 0, pathRule(path, rule), depth,
                            ExpandedInstance::kInherit, 0, Affine::identity());
+        if (out_.root_ != kNone) hierarchy(out_.root_);
         out_.nodes_.shrink_to_fit();
+        out_.bvh_.shrink_to_fit();
+        out_.items_.shrink_to_fit();
         out_.children_.shrink_to_fit();
         out_.matrices_.shrink_to_fit();
         out_.args_.shrink_to_fit();
@@ -46,6 +50,7 @@ class ExpansionBuilder {
   private:
     using Node = ExpandedInstance::Node;
     using Kind = ExpandedInstance::Kind;
+    using BvhNode = ExpandedInstance::BvhNode;
 
     // Builds what node n holds; returns its index, or kNone when it holds nothing. The
     // inverse matrices in pending_[pendingBase..] and the forward map `edge` lead from
@@ -184,6 +189,92 @@ class ExpansionBuilder {
         return x;
     }
 
+    // --- the first-hit BVHs of unions ---
+
+    // Flattening stops where an operand would need more matrices than this on its way.
+    static constexpr uint32_t kMaxChain = 12;
+    static constexpr uint32_t kLeafItems = 4;
+
+    // The operands of union u and of the unions nested in it, each as a node entered from
+    // u's frame: an operand below nested unions becomes a copy with their matrices in front
+    // of its own, and its box mapped into u's frame.
+    void collect(uint32_t u, const std::vector<Affine>& prefix, const Affine& toU,
+                 std::vector<uint32_t>& items) {
+        const Node un = out_.nodes_[u];
+        for (uint32_t i = 0; i < un.count; ++i) {
+            const uint32_t c = out_.children_[un.first + i];
+            const Node child = out_.nodes_[c];
+            std::vector<Affine> chain = prefix;
+            chain.insert(chain.end(), out_.matrices_.begin() + child.firstMatrix,
+                         out_.matrices_.begin() + child.firstMatrix + child.matrices);
+            if (child.kind == Kind::Union && chain.size() <= kMaxChain) {
+                Affine to = toU;
+                for (uint32_t k = 0; k < child.matrices; ++k)
+                    to = to * out_.matrices_[child.firstMatrix + k].inverse();
+                collect(c, chain, to, items);
+                continue;
+            }
+            if (prefix.empty()) {
+                items.push_back(c);
+                continue;
+            }
+            Node copy = child;
+            copy.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
+            copy.matrices = static_cast<uint32_t>(chain.size());
+            out_.matrices_.insert(out_.matrices_.end(), chain.begin(), chain.end());
+            copy.box = child.box.isEmpty() ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
+            copy.bvh = kNone;
+            out_.nodes_.push_back(copy);
+            items.push_back(static_cast<uint32_t>(out_.nodes_.size() - 1));
+        }
+    }
+
+    // Builds the BVHs of the unions that first hits reach through n.
+    void hierarchy(uint32_t n) {
+        if (out_.nodes_[n].kind != Kind::Union) return;
+        std::vector<uint32_t> items;
+        collect(n, {}, Affine::identity(), items);
+        for (uint32_t item : items) hierarchy(item);  // unions beyond the chain limit
+        if (items.size() <= kLeafItems) return;
+        out_.nodes_[n].bvh = split(items, 0, items.size());
+    }
+
+    uint32_t split(std::vector<uint32_t>& items, size_t begin, size_t end) {
+        BvhNode b;
+        Box centres;
+        for (size_t k = begin; k < end; ++k) {
+            const Box& box = out_.nodes_[items[k]].box;
+            b.box.extend(box);
+            if (!box.isEmpty()) centres.extend(box.center());
+        }
+        const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
+        out_.bvh_.push_back(b);
+        int axis = -1;
+        double widest = 0;
+        for (int a = 0; a < 3 && !centres.isEmpty(); ++a) {
+            const double w = centres.hi[a] - centres.lo[a];
+            if (std::isfinite(w) && w > widest) widest = w, axis = a;
+        }
+        if (end - begin <= kLeafItems || axis < 0) {
+            out_.bvh_[index].first = static_cast<uint32_t>(out_.items_.size());
+            out_.bvh_[index].count = static_cast<uint32_t>(end - begin);
+            out_.items_.insert(out_.items_.end(), items.begin() + begin, items.begin() + end);
+            return index;
+        }
+        const size_t mid = begin + (end - begin) / 2;
+        auto centre = [&](uint32_t i) {
+            const Box& box = out_.nodes_[i].box;
+            return box.isEmpty() ? 0.0 : box.center()[axis];
+        };
+        std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                         [&](uint32_t a, uint32_t b2) { return centre(a) < centre(b2); });
+        const uint32_t left = split(items, begin, mid);
+        const uint32_t right = split(items, mid, end);
+        out_.bvh_[index].left = left;
+        out_.bvh_[index].right = right;
+        return index;
+    }
+
     void setChoices(Node& x) {
         x.firstChoice = static_cast<uint32_t>(out_.choices_.size());
         x.choices = static_cast<uint32_t>(choices_.size());
@@ -207,7 +298,8 @@ class ExpansionBuilder {
 size_t ExpandedInstance::bytes() const {
     return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
-           args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t);
+           args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t) +
+           bvh_.capacity() * sizeof(BvhNode) + items_.capacity() * sizeof(uint32_t);
 }
 
 LocalRay ExpandedInstance::enter(const Node& node, const LocalRay& r) const {
@@ -288,6 +380,10 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             break;
         }
         case Kind::Union:
+            if (node.bvh != kNone) {
+                found = firstBvh(node.bvh, rr, tmin, tmax, hit, use, anyHit, s);
+                break;
+            }
             found = firstOfUnion(
                 node.count, tmin, tmax, hit, anyHit, s.order,
                 [&](uint32_t i, double& t0) {
@@ -312,6 +408,31 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
     }
     if (found) hit.normal = leave(node, hit.normal);
     return found;
+}
+
+bool ExpandedInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax,
+                                Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
+    const BvhNode& bn = bvh_[b];
+    if (bn.left == kNone)
+        return firstOfUnion(
+            bn.count, tmin, tmax, hit, anyHit, s.order,
+            [&](uint32_t i, double& t0) {
+                double t1 = tmax;
+                return clipToBox(nodes_[items_[bn.first + i]].box, r.o, r.d, t0, t1);
+            },
+            [&](uint32_t i, double& best, Hit& h) {
+                return firstAt(items_[bn.first + i], r, tmin, best, h, use, anyHit, s);
+            });
+    const uint32_t halves[2] = {bn.left, bn.right};
+    return firstOfUnion(
+        2, tmin, tmax, hit, anyHit, s.order,
+        [&](uint32_t i, double& t0) {
+            double t1 = tmax;
+            return clipToBox(bvh_[halves[i]].box, r.o, r.d, t0, t1);
+        },
+        [&](uint32_t i, double& best, Hit& h) {
+            return firstBvh(halves[i], r, tmin, best, h, use, anyHit, s);
+        });
 }
 
 size_t ExpandedInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,

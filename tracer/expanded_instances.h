@@ -54,7 +54,18 @@ class ExpandedInstance {
         uint32_t firstMatrix = 0, matrices = 0;  // inverse matrices applied on entering
         uint32_t first = 0, count = 0;           // operators: children; primitives: args
         uint32_t firstChoice = 0, choices = 0;   // the path from the S-node (hit sources)
+        uint32_t bvh = kNone;                    // unions: the root of their first-hit BVH
         Box box;  // what the node holds, in the frame it is entered from, padded
+    };
+
+    // First hits through nested unions: the operands of a union and of the unions nested in
+    // it (each operand with the matrices on its way, so the arithmetic stays the same) in a
+    // bounding-volume hierarchy, because the derivation nests them as the rules do (a
+    // flower's 21 petals as a chain 21 unions deep). Spans still follow the derivation.
+    struct BvhNode {
+        Box box;
+        uint32_t left = kNone, right = kNone;  // inner nodes
+        uint32_t first = 0, count = 0;         // leaves: operands in items_
     };
 
     // Where an instance is used: the S-node's instance path and the material above it.
@@ -84,6 +95,7 @@ class ExpandedInstance {
     // deepest of them stays within max_depth).
     uint32_t levels() const { return levels_; }
     size_t bytes() const;
+    size_t bvhNodes() const { return bvh_.size(); }
 
   private:
     friend class ExpansionBuilder;
@@ -92,6 +104,8 @@ class ExpandedInstance {
                  const Use& use, bool anyHit, Scratch& s) const;
     size_t spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
                    std::vector<Span>& spans, const Use& use, Scratch& s) const;
+    bool firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                  const Use& use, bool anyHit, Scratch& s) const;
     LocalRay enter(const Node& node, const LocalRay& r) const;
     Vec3 leave(const Node& node, Vec3 normal) const;
     uint64_t keyOf(const Node& node, uint64_t path) const;
@@ -101,6 +115,8 @@ class ExpandedInstance {
     std::vector<Affine> matrices_;
     std::vector<double> args_;
     std::vector<uint32_t> choices_;  // bit 31: a rule of an S-node, else an operand
+    std::vector<BvhNode> bvh_;
+    std::vector<uint32_t> items_;
     uint32_t root_ = kNone;
     uint32_t levels_ = 0;
 };

@@ -138,6 +138,35 @@ TEST(ExpandedInstances, SierpinskiHitsTheSameSurfacesBitForBit) {
     EXPECT_GT(compareWithGraphWalk(testing::kSierpinski, 1.0), 0u);
 }
 
+// A flower head: 21 petals as a chain of unions 21 deep, each a rotation further on.
+const char* kChain = R"(
+material petal { color <1, 1, 0.9> }
+{p = 21} F
+F if(p > 0, 2, 1)
+1: F -> scale(0.2, 0.2, 0.1) sphere
+2: F -> paint(petal) roty(-12 - 10*mod(p, 2)) move(0.45, 0, 0) scale(0.36, 0.08, 0.02) sphere ∪
+        {p = p-1} rotz(360/21) F
+)";
+
+TEST(ExpandedInstances, AChainOfUnionsGetsAHierarchyAndTheSameHits) {
+    EXPECT_GT(compareWithGraphWalk(kChain, 0.6, 100), 0u);
+    auto c = compile(kChain);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene scene(g, computeBounds(g), true, eager());
+    ExpansionCache cache(scene, 1u << 20);
+    std::vector<double> root(g.slotCount()), frame(g.slotCount());
+    initFrame(g, root.data());
+    applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, frame.data());
+    const NodeId s = g.child(g.axiom);
+    EXPECT_EQ(cache.get(s, 1, frame.data(), kRootPath), nullptr);  // the first meeting: a note
+    const ExpandedInstance* x = cache.get(s, 1, frame.data(), kRootPath);
+    ASSERT_NE(x, nullptr);
+    // 22 primitives under one hierarchy: at least 22 / 4 leaves.
+    EXPECT_GE(x->bvhNodes(), 6u);
+    EXPECT_EQ(cache.expansions(), 1u);
+}
+
 TEST(ExpandedInstances, TheCacheStaysWithinItsBudget) {
     auto c = compile(kPlant);
     ASSERT_TRUE(c->graph);
