@@ -24,6 +24,7 @@
 // scene (in depth-first order, so the sample is deterministic); the Release build checks
 // them all.
 #include <gtest/gtest.h>
+#include "sanitizer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -41,17 +42,6 @@
 namespace pcsg::tracer {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
 constexpr uint64_t kSanitizerLimit = 150'000;
 
 const char* kindName(NodeKind k) {
@@ -311,7 +301,7 @@ TEST_P(BoundsOnScenes, EveryInstanceLiesInEveryBoxOnItsPath) {
     ASSERT_TRUE(scene->graph) << scene->diags.format();
     const Graph& g = *scene->graph;
     const Bounds b = computeBounds(g, rawAnalysis());
-    const uint64_t limit = kSanitized ? kSanitizerLimit : UINT64_MAX;
+    const uint64_t limit = kAddressSanitizer ? kSanitizerLimit : UINT64_MAX;
     const SoundnessReport r = StreamingSoundness(g, b, limit).run();
     EXPECT_GT(r.instances, 0u);
     EXPECT_GE(r.checks, r.instances);

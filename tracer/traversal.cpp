@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "operators.h"
+#include "sanitizer.h"
 
 namespace pcsg::tracer {
 
@@ -18,17 +19,7 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr size_t kBytesPerVisit = 4096;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr size_t kBytesPerVisit = 4096;
-#else
-constexpr size_t kBytesPerVisit = 512;
-#endif
-#else
-constexpr size_t kBytesPerVisit = 512;
-#endif
+constexpr size_t kBytesPerVisit = kAddressSanitizer ? 4096 : 512;
 
 // Room left below the guard for a primitive's intersection, the evaluation code and an
 // exception's unwinding.

@@ -21,6 +21,7 @@
 #include "traversal.h"
 
 #include <gtest/gtest.h>
+#include "sanitizer.h"
 
 #include <algorithm>
 #include <array>
@@ -501,17 +502,7 @@ void expectAgreement(const char* text, int count, uint32_t seed, std::array<int,
     EXPECT_LE(t.ambiguous, t.rays / 100) << "too many rays end on a surface";
 }
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kRays = 400;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr int kRays = 400;
-#else
-constexpr int kRays = 3000;
-#endif
-#else
-constexpr int kRays = 3000;
-#endif
+constexpr int kRays = kAddressSanitizer ? 400 : 3000;
 
 // Mirrors (flipxz, flipyz, flipxy), a shear, rot about a slanted axis, matrix, rotations
 // by parameters, all six solid primitives with a torus of parameter radius, paint at two
