@@ -384,15 +384,8 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                 found = firstBvh(node.bvh, rr, tmin, tmax, hit, use, anyHit, s);
                 break;
             }
-            found = firstOfUnion(
-                node.count, tmin, tmax, hit, anyHit, s.order,
-                [&](uint32_t i, double& t0) {
-                    double t1 = tmax;
-                    return clipToBox(nodes_[children_[node.first + i]].box, rr.o, rr.d, t0, t1);
-                },
-                [&](uint32_t i, double& best, Hit& h) {
-                    return firstAt(children_[node.first + i], rr, tmin, best, h, use, anyHit, s);
-                });
+            found = firstOfNodes(children_.data() + node.first, node.count, rr, tmin, tmax, hit,
+                                 use, anyHit, s);
             break;
         case Kind::Intersection:
         case Kind::Difference: {
@@ -410,19 +403,27 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
     return found;
 }
 
+// The first hit among the nodes list[0..count), all entered from the same frame, as the
+// operands of a union.
+bool ExpandedInstance::firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r,
+                                    double tmin, double& tmax, Hit& hit, const Use& use,
+                                    bool anyHit, Scratch& s) const {
+    return firstOfUnion(
+        count, tmin, tmax, hit, anyHit, s.order,
+        [&](uint32_t i, double& t0) {
+            double t1 = tmax;
+            return clipToBox(nodes_[list[i]].box, r.o, r.d, t0, t1);
+        },
+        [&](uint32_t i, double& best, Hit& h) {
+            return firstAt(list[i], r, tmin, best, h, use, anyHit, s);
+        });
+}
+
 bool ExpandedInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax,
                                 Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
     const BvhNode& bn = bvh_[b];
     if (bn.left == kNone)
-        return firstOfUnion(
-            bn.count, tmin, tmax, hit, anyHit, s.order,
-            [&](uint32_t i, double& t0) {
-                double t1 = tmax;
-                return clipToBox(nodes_[items_[bn.first + i]].box, r.o, r.d, t0, t1);
-            },
-            [&](uint32_t i, double& best, Hit& h) {
-                return firstAt(items_[bn.first + i], r, tmin, best, h, use, anyHit, s);
-            });
+        return firstOfNodes(items_.data() + bn.first, bn.count, r, tmin, tmax, hit, use, anyHit, s);
     const uint32_t halves[2] = {bn.left, bn.right};
     return firstOfUnion(
         2, tmin, tmax, hit, anyHit, s.order,

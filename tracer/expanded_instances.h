@@ -104,6 +104,8 @@ class ExpandedInstance {
                  const Use& use, bool anyHit, Scratch& s) const;
     size_t spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
                    std::vector<Span>& spans, const Use& use, Scratch& s) const;
+    bool firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r, double tmin,
+                      double& tmax, Hit& hit, const Use& use, bool anyHit, Scratch& s) const;
     bool firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
                   const Use& use, bool anyHit, Scratch& s) const;
     LocalRay enter(const Node& node, const LocalRay& r) const;
