@@ -18,6 +18,9 @@
 //    and for every operand of an operator, in every cycle. Where the static boxes are
 //    loose, an S-node also tests the exact box of the instance at hand
 //    (instance_boxes.h: a lazily filled, memory-bounded cache).
+//  - Small instances that rays keep meeting are expanded once per thread
+//    (expanded_instances.h) and traced as flat arrays with the same matrices, so the
+//    walk below them finds the same surfaces bit for bit without re-evaluating them.
 //  - Ties: of two surfaces at exactly the same distance, the one with the smaller
 //    instance path wins, whatever the order the walk found them in. So the image does
 //    not depend on which boxes culled what (and the instance boxes' decisions depend on
