@@ -6,6 +6,7 @@
 
 #include <OpenImageIO/imagebufalgo.h>
 
+#include "heat_ramp.h"
 #include "image_format.h"
 
 namespace pcsg::tools {
@@ -103,12 +104,8 @@ OIIO::ImageBuf diffHeatMap(const OIIO::ImageBuf& a, const OIIO::ImageBuf& b) {
             float d = 0;
             for (int c = 0; c < 3; ++c)
                 d = std::max(d, std::fabs(linearToSrgb(pa[c]) - linearToSrgb(pb[c])));
-            // Amplified so that small differences show: 0.25 already reaches white.
-            const float h = std::min(1.0f, d * 4.0f);
-            const float rgb[3] = {std::min(1.0f, 3 * h), std::clamp(3 * h - 1, 0.0f, 1.0f),
-                                  std::clamp(3 * h - 2, 0.0f, 1.0f)};
-            float lin[3];
-            for (int c = 0; c < 3; ++c) lin[c] = srgbToLinear(rgb[c]);
+            const HeatRgb rgb = heatColour(d);
+            const float lin[3] = {srgbToLinear(rgb.r), srgbToLinear(rgb.g), srgbToLinear(rgb.b)};
             out.setpixel(x, y, lin, 3);
         }
     return out;

@@ -22,6 +22,7 @@
 
 #include "child_process.h"
 #include "commands.h"
+#include "heat_ramp.h"
 #include "image_helper.h"
 #include "renders.h"
 #include "stats.h"
@@ -326,8 +327,7 @@ img{border:1px solid #999;background:#fff}img.pixels{image-rendering:pixelated}
 img[data-state=broken]{outline:3px solid #d00;min-width:6em;min-height:3em}
 .marker{position:absolute;width:18px;height:18px;margin:-11px 0 0 -11px;border:2px solid #0cf;
  border-radius:50%;pointer-events:none}
-.ramp{height:12px;border:1px solid #999;
- background:linear-gradient(to right,#000 0%,#f00 33.33%,#ff0 66.67%,#fff 100%)}
+.ramp{height:12px;border:1px solid #999}
 .ticks{position:relative;height:1.3em}
 .ticks span{position:absolute;transform:translateX(-50%)}
 .ticks span.first{transform:none}.ticks span.last{transform:translateX(-100%)}
@@ -416,17 +416,23 @@ std::string settingsHtml(const VerifyOptions& o) {
     return h;
 }
 
-// The colour ramp of diff.png (image_compare.cpp's diffHeatMap): a pixel's largest channel
-// difference d is drawn black at 0, red at 1/12, yellow at 1/6, white from 1/4 up.
+// The colour ramp of diff.png (heat_ramp.h, which diffHeatMap draws with): the gradient
+// and a tick at every stop, with the threshold of an "off" pixel marked on it.
 std::string heatLegend(double pixelOff) {
-    const double at = std::clamp(pixelOff * 4, 0.0, 1.0) * 100;
+    const double at = std::clamp(pixelOff / kHeatFullScale, 0.0, 1.0) * 100;
+    std::string ticks;
+    for (size_t i = 0; i < kHeatStops.size(); ++i) {
+        const bool first = i == 0, last = i + 1 == kHeatStops.size();
+        const double d = double(kHeatStops[i].at) * kHeatFullScale;
+        ticks += fmt::format("<span{} style=\"left:{:.2f}%\">{}{}</span>",
+                             first ? " class=first" : last ? " class=last" : "",
+                             100.0 * kHeatStops[i].at, last ? "&ge;&nbsp;" : "",
+                             first ? std::string("0") : fmt::format("{:.3g}", d));
+    }
     return fmt::format(
         "<div class=legend><span class=threshold style=\"left:{:.1f}%\">off above {:g}</span>"
-        "<div class=ramp></div><div class=ticks><span class=first style=\"left:0\">0</span><span "
-        "style=\"left:33.33%\">0.083</span>"
-        "<span style=\"left:66.67%\">0.167</span><span class=last style=\"left:100%\">"
-        "&ge;&nbsp;0.25</span></div></div>",
-        at, pixelOff);
+        "<div class=ramp style=\"background:{}\"></div><div class=ticks>{}</div></div>",
+        at, pixelOff, heatCssGradient(), ticks);
 }
 
 std::string metricsTable(const SceneResult& r, const Thresholds& t) {
