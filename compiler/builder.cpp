@@ -77,7 +77,7 @@ public:
         : src_(src), t_(ts.tokens), ast_(ast), diags_(diags) {}
 
     std::optional<Graph> run() {
-        const size_t errorsBefore = diags_.errors().size();
+        const size_t errorsBefore = diags_.count();
         g_.files = diags_.fileNames();
         reserve();
         for (uint32_t tok : ast_.droppedNames) dropped_.insert(text(tok));
@@ -90,7 +90,7 @@ public:
         buildGraph(order);
         triangles();
         if (g_.scene.lights.empty()) g_.scene.lights.push_back(Light{});
-        if (diags_.errors().size() != errorsBefore) return std::nullopt;
+        if (diags_.count() != errorsBefore) return std::nullopt;
         return std::move(g_);
     }
 
@@ -145,11 +145,17 @@ private:
         const size_t codeSize = g_.code.size(), exprCount = g_.exprs.size();
         const uint32_t sites = g_.randCallSites;
         constantOnly_ = true;
-        const size_t errors = diags_.errors().size();
+        const size_t errors = diags_.count();
         const ExprId id = compile(e);
         constantOnly_ = false;
         std::optional<double> value;
-        if (diags_.errors().size() == errors) {
+        if (diags_.count() != errors) {
+            // reported already (a parameter, rand(), a syntax error): nothing to evaluate
+        } else if (!g_.exprs[id].constant) {
+            // compile() reports every way to be non-constant; should it miss one, this
+            // error stands in for it, as evaluating needs a frame there is none of
+            error(ast_.exprs[e].from, fmt::format("'{}' is not a constant", g_.exprs[id].text));
+        } else {
             const double v = evalExpr(g_, id, EvalState{nullptr, kRootPath});
             if (std::isfinite(v)) value = v;
             else error(ast_.exprs[e].from, fmt::format("'{}' is {}, not a finite number", g_.exprs[id].text, v));

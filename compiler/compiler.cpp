@@ -17,7 +17,7 @@ namespace pcsg {
 
 std::optional<Graph> compileSource(std::string_view fileName, std::string_view text,
                                    Diagnostics& diags, const CompileOptions& options) {
-    const size_t errorsBefore = diags.errors().size();
+    const size_t errorsBefore = diags.count();
     const uint32_t file = diags.addFile(std::string(fileName), text);
     if (text.size() > kMaxSourceBytes) {
         diags.error(FileLoc{file, 0, 0},
@@ -28,7 +28,7 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
     const Source src(text, file);
     const TokenStream tokens = lex(src, diags);
     if (!tokens.complete) return std::nullopt;  // the rest of the file was not read
-    if (diags.errors().size() == errorsBefore && tokens.tokens.size() == 1) {
+    if (diags.count() == errorsBefore && tokens.tokens.size() == 1) {
         diags.error(FileLoc{file, 1, 1}, "the file is empty: a scene needs at least an axiom, "
                                          "such as 'sphere'");
         return std::nullopt;
@@ -38,7 +38,7 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
     // The builder's checks run even after syntax errors (they are told what was dropped),
     // so that one run reports as many independent errors as it can.
     std::optional<Graph> g = build(src, tokens, ast, diags);
-    if (diags.errors().size() != errorsBefore) return std::nullopt;
+    if (diags.count() != errorsBefore) return std::nullopt;
     if (g && options.foldConstants) foldConstantParameters(*g);
     return g;
 }

@@ -23,6 +23,7 @@ void Diagnostics::error(FileLoc loc, std::string message) {
         message.resize(cut);
         message += "...";
     }
+    ++reported_;
     if (errors_.size() + 1 < kMaxErrors) {
         errors_.push_back(Diagnostic{loc, std::move(message)});
     } else if (errors_.size() + 1 == kMaxErrors) {

@@ -26,6 +26,10 @@ public:
     void error(FileLoc loc, std::string message);
     bool hasErrors() const { return !errors_.empty(); }
     const std::vector<Diagnostic>& errors() const { return errors_; }
+    // How many errors were reported, counting those past kMaxErrors that are not kept:
+    // "did this step report an error" compares count()s, which errors().size() cannot
+    // answer once the list is full.
+    size_t count() const { return reported_; }
 
     // All diagnostics, each as "file:line:col: error: message", the source line and a
     // caret under the column (a line longer than 200 bytes is shown around the column).
@@ -39,6 +43,7 @@ private:
     std::vector<std::string> names_;
     std::vector<std::string_view> texts_;
     std::vector<Diagnostic> errors_;
+    size_t reported_ = 0;
 };
 
 }  // namespace pcsg

@@ -152,6 +152,22 @@ TEST(Robustness, TooManyErrorsStopAtTheLimit) {
     EXPECT_NE(d.errors().back().message.find("too many errors"), std::string::npos);
 }
 
+// Once the list of errors is full, an error adds nothing to it, yet the steps that ask
+// "did this report an error" must still see it: a directive value that reads a parameter
+// was evaluated without a frame here and crashed (found by the parser fuzzer).
+TEST(Robustness, ErrorsPastTheLimitStillCount) {
+    std::string text = "{n = 1} S\nS 1\n1: S -> sphere\n";
+    for (int i = 0; i < 60; ++i)
+        text += "light { position <10, n - 20, 30>  color <1, 1, 1> }\n";
+    Diagnostics d;
+    EXPECT_FALSE(compileSource("full.pcsg", text, d));
+    ASSERT_EQ(d.errors().size(), Diagnostics::kMaxErrors);
+    EXPECT_EQ(d.count(), 60u);
+    EXPECT_NE(d.errors().back().message.find("too many errors"), std::string::npos);
+    EXPECT_NE(d.errors().front().message.find("constants, not parameters"), std::string::npos)
+        << d.errors().front().message;
+}
+
 TEST(Robustness, ALargeGeneratedFileCompiles) {
     // About 2.5 MB: 16,000 modules of two rules each, chained, and as many definitions.
     std::string text = "{n = 1} M0\n";
