@@ -424,10 +424,9 @@ std::string heatLegend(double pixelOff) {
     for (size_t i = 0; i < kHeatStops.size(); ++i) {
         const bool first = i == 0, last = i + 1 == kHeatStops.size();
         const double d = double(kHeatStops[i].at) * kHeatFullScale;
-        ticks += fmt::format("<span{} style=\"left:{:.2f}%\">{}{}</span>",
+        ticks += fmt::format("<span{} style=\"left:{:.2f}%\">{}{:.3g}</span>",
                              first ? " class=first" : last ? " class=last" : "",
-                             100.0 * kHeatStops[i].at, last ? "&ge;&nbsp;" : "",
-                             first ? std::string("0") : fmt::format("{:.3g}", d));
+                             100.0 * kHeatStops[i].at, last ? "&ge;&nbsp;" : "", d);
     }
     return fmt::format(
         "<div class=legend><span class=threshold style=\"left:{:.1f}%\">off above {:g}</span>"
