@@ -18,7 +18,7 @@ namespace pcsg {
 inline constexpr uint32_t kNoNode = UINT32_MAX;
 
 // ---------------------------------------------------------------------------------------
-// Arithmetic expressions (LANGUAGE.md section 3).
+// Arithmetic expressions (docs/language.md section 3).
 
 enum class ExKind : uint8_t {
     Number,  // value
@@ -33,11 +33,11 @@ enum class ExKind : uint8_t {
 
 struct ExNode {
     ExKind kind;
-    Tok op = Tok::End;         // Unary's operator
-    uint32_t tok = 0;          // the token that names it: the number, parameter, operator
-                               // or function (Chain, Power: the first token)
-    uint32_t from = 0, to = 0; // its first and last token, parentheses included
-    double value = 0;          // Number
+    Tok op = Tok::End;          // Unary's operator
+    uint32_t tok = 0;           // the token that names it: the number, parameter, operator
+                                // or function (Chain, Power: the first token)
+    uint32_t from = 0, to = 0;  // its first and last token, parentheses included
+    double value = 0;           // Number
     uint32_t a = kNoNode, b = kNoNode;
     uint32_t first = 0, count = 0;
 };
@@ -52,13 +52,15 @@ struct ChainItem {
 // CSG expressions (section 5).
 
 enum class CsgKind : uint8_t {
-    Union, Intersection, Difference,  // operands [first, first+count) of Ast::lists
-    Transform,  // `op` on `child`; its arguments [first, first+count) of Ast::lists (ExNodes)
-    Calc,       // a C-node { ... } on `child`; assignments [first, first+count) of Ast::assigns
-    Paint,      // paint(name) on `child`; the material's name at `nameTok`
-    Primitive,  // `prim`; arguments [first, first+count) of Ast::lists (ExNodes)
-    Name,       // a module or definition name at `nameTok`
-    Call,       // a notation-B call `S(e1, ...)`: S at `nameTok`, arguments as for Transform
+    Union,
+    Intersection,
+    Difference,  // operands [first, first+count) of Ast::lists
+    Transform,   // `op` on `child`; its arguments [first, first+count) of Ast::lists (ExNodes)
+    Calc,        // a C-node { ... } on `child`; assignments [first, first+count) of Ast::assigns
+    Paint,       // paint(name) on `child`; the material's name at `nameTok`
+    Primitive,   // `prim`; arguments [first, first+count) of Ast::lists (ExNodes)
+    Name,        // a module or definition name at `nameTok`
+    Call,        // a notation-B call `S(e1, ...)`: S at `nameTok`, arguments as for Transform
 };
 
 struct CsgNode {
@@ -99,16 +101,16 @@ struct DirectiveItem {
 
 struct Stmt {
     StmtKind kind;
-    uint32_t tok = 0;                 // the first token
-    uint32_t nameTok = 0;             // module (rules, Module), definition or material name
-    uint32_t labelTok = 0;            // RuleB / AxiomB label, RuleA number
-    Kw directive = Kw::None;          // Directive: which one
-    uint32_t number = 0;              // RuleA: the rule number
-    uint32_t expr = kNoNode;          // Module: selection; RuleB: condition (kNoNode: none)
-    uint32_t body = kNoNode;          // CsgNode index
-    uint32_t first = 0, count = 0;    // RuleB formals (token indices in Ast::lists);
-                                      // Directive items [first, first+count) of Ast::items
-    bool hasFormals = false;          // RuleB: `S(...)` rather than `S`
+    uint32_t tok = 0;               // the first token
+    uint32_t nameTok = 0;           // module (rules, Module), definition or material name
+    uint32_t labelTok = 0;          // RuleB / AxiomB label, RuleA number
+    Kw directive = Kw::None;        // Directive: which one
+    uint32_t number = 0;            // RuleA: the rule number
+    uint32_t expr = kNoNode;        // Module: selection; RuleB: condition (kNoNode: none)
+    uint32_t body = kNoNode;        // CsgNode index
+    uint32_t first = 0, count = 0;  // RuleB formals (token indices in Ast::lists);
+                                    // Directive items [first, first+count) of Ast::items
+    bool hasFormals = false;        // RuleB: `S(...)` rather than `S`
 };
 
 struct Ast {

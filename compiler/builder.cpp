@@ -1,12 +1,12 @@
 // The builder: whole-file checks, then the Graph. See builder.h.
 #include "builder.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
 #include <unordered_set>
-
-#include <fmt/format.h>
 
 #include "eval.h"
 
@@ -21,15 +21,12 @@ struct FuncInfo {
 };
 
 constexpr FuncInfo kFunctions[] = {
-    {Kw::Sin, Func::Sin, 1, 1},     {Kw::Cos, Func::Cos, 1, 1},
-    {Kw::Tan, Func::Tan, 1, 1},     {Kw::Asin, Func::Asin, 1, 1},
-    {Kw::Acos, Func::Acos, 1, 1},   {Kw::Atan, Func::Atan, 1, 1},
-    {Kw::Atan2, Func::Atan2, 2, 2}, {Kw::Sqrt, Func::Sqrt, 1, 1},
-    {Kw::Exp, Func::Exp, 1, 1},     {Kw::Ln, Func::Ln, 1, 1},
-    {Kw::Log10, Func::Log10, 1, 1}, {Kw::Pow, Func::Pow, 2, 2},
-    {Kw::Abs, Func::Abs, 1, 1},     {Kw::Floor, Func::Floor, 1, 1},
-    {Kw::Ceil, Func::Ceil, 1, 1},   {Kw::Min, Func::Min, 2, 255},
-    {Kw::Max, Func::Max, 2, 255},   {Kw::Mod, Func::Mod, 2, 2},
+    {Kw::Sin, Func::Sin, 1, 1},     {Kw::Cos, Func::Cos, 1, 1},     {Kw::Tan, Func::Tan, 1, 1},
+    {Kw::Asin, Func::Asin, 1, 1},   {Kw::Acos, Func::Acos, 1, 1},   {Kw::Atan, Func::Atan, 1, 1},
+    {Kw::Atan2, Func::Atan2, 2, 2}, {Kw::Sqrt, Func::Sqrt, 1, 1},   {Kw::Exp, Func::Exp, 1, 1},
+    {Kw::Ln, Func::Ln, 1, 1},       {Kw::Log10, Func::Log10, 1, 1}, {Kw::Pow, Func::Pow, 2, 2},
+    {Kw::Abs, Func::Abs, 1, 1},     {Kw::Floor, Func::Floor, 1, 1}, {Kw::Ceil, Func::Ceil, 1, 1},
+    {Kw::Min, Func::Min, 2, 255},   {Kw::Max, Func::Max, 2, 255},   {Kw::Mod, Func::Mod, 2, 2},
     {Kw::Clamp, Func::Clamp, 3, 3},
 };
 
@@ -39,7 +36,9 @@ const FuncInfo* functionInfo(Kw k) {
     return nullptr;
 }
 
-std::string argumentCount(uint32_t n) { return fmt::format("{} argument{}", n, n == 1 ? "" : "s"); }
+std::string argumentCount(uint32_t n) {
+    return fmt::format("{} argument{}", n, n == 1 ? "" : "s");
+}
 
 struct TransformInfo {
     uint32_t args;
@@ -47,18 +46,26 @@ struct TransformInfo {
 };
 TransformInfo transformInfo(TransformOp op) {
     switch (op) {
-        case TransformOp::Move: return {3, "dx, dy, dz"};
-        case TransformOp::Scale: return {3, "fx, fy, fz"};
-        case TransformOp::UScale: return {1, "f"};
+        case TransformOp::Move:
+            return {3, "dx, dy, dz"};
+        case TransformOp::Scale:
+            return {3, "fx, fy, fz"};
+        case TransformOp::UScale:
+            return {1, "f"};
         case TransformOp::RotX:
         case TransformOp::RotY:
-        case TransformOp::RotZ: return {1, "an angle in degrees"};
-        case TransformOp::Rot: return {4, "ax, ay, az, angle"};
-        case TransformOp::ZShear: return {2, "a, b"};
+        case TransformOp::RotZ:
+            return {1, "an angle in degrees"};
+        case TransformOp::Rot:
+            return {4, "ax, ay, az, angle"};
+        case TransformOp::ZShear:
+            return {2, "a, b"};
         case TransformOp::FlipYZ:
         case TransformOp::FlipXZ:
-        case TransformOp::FlipXY: return {0, ""};
-        case TransformOp::Matrix: return {12, "m11 ... m33, tx, ty, tz"};
+        case TransformOp::FlipXY:
+            return {0, ""};
+        case TransformOp::Matrix:
+            return {12, "m11 ... m33, tx, ty, tz"};
     }
     return {0, ""};
 }
@@ -72,7 +79,7 @@ bool isTriangle(PrimitiveKind k) {
 }
 
 class Builder {
-public:
+  public:
     Builder(const Source& src, const TokenStream& ts, const Ast& ast, Diagnostics& diags)
         : src_(src), t_(ts.tokens), ast_(ast), diags_(diags) {}
 
@@ -94,7 +101,7 @@ public:
         return std::move(g_);
     }
 
-private:
+  private:
     // Upper bounds from the AST, so that no array of the graph is copied while it grows.
     void reserve() {
         const size_t csg = ast_.csg.size(), exprs = ast_.exprs.size(), lists = ast_.lists.size();
@@ -157,8 +164,11 @@ private:
             error(ast_.exprs[e].from, fmt::format("'{}' is not a constant", g_.exprs[id].text));
         } else {
             const double v = evalExpr(g_, id, EvalState{nullptr, kRootPath});
-            if (std::isfinite(v)) value = v;
-            else error(ast_.exprs[e].from, fmt::format("'{}' is {}, not a finite number", g_.exprs[id].text, v));
+            if (std::isfinite(v))
+                value = v;
+            else
+                error(ast_.exprs[e].from,
+                      fmt::format("'{}' is {}, not a finite number", g_.exprs[id].text, v));
         }
         g_.code.resize(codeSize);
         g_.exprs.resize(exprCount);
@@ -171,8 +181,10 @@ private:
         bool ok = true;
         for (int i = 0; i < 3; ++i) {
             const auto c = constant(item.e[i]);
-            if (c) v[i] = *c;
-            else ok = false;
+            if (c)
+                v[i] = *c;
+            else
+                ok = false;
         }
         if (!ok) return std::nullopt;
         return v;
@@ -192,14 +204,16 @@ private:
 
     std::optional<Vec3> wantVector(const DirectiveItem& item) {
         if (!item.vector) {
-            error(item.nameTok, fmt::format("'{}' takes a vector '<x, y, z>'", clip(text(item.nameTok))));
+            error(item.nameTok,
+                  fmt::format("'{}' takes a vector '<x, y, z>'", clip(text(item.nameTok))));
             return std::nullopt;
         }
         return vectorValue(item);
     }
     std::optional<double> wantScalar(const DirectiveItem& item) {
         if (item.vector) {
-            error(item.nameTok, fmt::format("'{}' takes a number, not a vector", clip(text(item.nameTok))));
+            error(item.nameTok,
+                  fmt::format("'{}' takes a number, not a vector", clip(text(item.nameTok))));
             return std::nullopt;
         }
         return constant(item.e[0]);
@@ -214,18 +228,28 @@ private:
         for (const Stmt& s : ast_.stmts) {
             if (s.kind != StmtKind::Directive) continue;
             switch (s.directive) {
-                case Kw::Camera: camera(s); break;
-                case Kw::Light: light(s); break;
-                case Kw::Background: background(s); break;
-                case Kw::Material: material(s); break;
-                default: break;
+                case Kw::Camera:
+                    camera(s);
+                    break;
+                case Kw::Light:
+                    light(s);
+                    break;
+                case Kw::Background:
+                    background(s);
+                    break;
+                case Kw::Material:
+                    material(s);
+                    break;
+                default:
+                    break;
             }
         }
     }
 
     bool once(uint32_t& seen, const Stmt& s, const char* what) {
         if (seen != kNoNode) {
-            error(s.tok, fmt::format("a second {} directive (the first is at line {})", what, line(seen)));
+            error(s.tok,
+                  fmt::format("a second {} directive (the first is at line {})", what, line(seen)));
             return false;
         }
         seen = s.tok;
@@ -239,14 +263,20 @@ private:
             if (n == "seed") {
                 if (auto v = wantScalar(item)) {
                     if (*v < 0 || *v != std::floor(*v) || *v > 9007199254740992.0)
-                        error(item.nameTok, fmt::format("seed must be a whole number from 0 to 2^53, found {}", *v));
-                    else st.seed = static_cast<uint64_t>(*v);
+                        error(item.nameTok,
+                              fmt::format("seed must be a whole number from 0 to 2^53, found {}",
+                                          *v));
+                    else
+                        st.seed = static_cast<uint64_t>(*v);
                 }
             } else if (n == "max_depth") {
                 if (auto v = wantScalar(item)) {
                     if (*v < 1 || *v != std::floor(*v) || *v > kMaxMaxDepth)
-                        error(item.nameTok, fmt::format("max_depth must be a whole number from 1 to {}, found {}", kMaxMaxDepth, *v));
-                    else st.maxDepth = static_cast<uint32_t>(*v);
+                        error(item.nameTok,
+                              fmt::format("max_depth must be a whole number from 1 to {}, found {}",
+                                          kMaxMaxDepth, *v));
+                    else
+                        st.maxDepth = static_cast<uint32_t>(*v);
                 }
             } else {
                 return false;
@@ -259,33 +289,40 @@ private:
         if (!once(cameraSeen_, s, "camera")) return;
         Camera& c = g_.scene.camera;
         bool ok = true;
-        items(s, "camera", "location, look_at, sky, angle", [&](std::string_view n, const DirectiveItem& item) {
-            std::optional<Vec3> v;
-            if (n == "location") {
-                if ((v = wantVector(item))) c.location = *v;
-            } else if (n == "look_at") {
-                if ((v = wantVector(item))) c.lookAt = *v;
-            } else if (n == "sky") {
-                if ((v = wantVector(item))) c.sky = *v;
-            } else if (n == "angle") {
-                if (auto a = wantScalar(item)) {
-                    if (!(*a > 0 && *a < 180)) {
-                        error(item.nameTok, fmt::format("the camera angle must be between 0 and 180 degrees, found {}", *a));
-                        ok = false;
-                    } else {
-                        c.angle = *a;
+        items(
+            s, "camera", "location, look_at, sky, angle",
+            [&](std::string_view n, const DirectiveItem& item) {
+                std::optional<Vec3> v;
+                if (n == "location") {
+                    if ((v = wantVector(item))) c.location = *v;
+                } else if (n == "look_at") {
+                    if ((v = wantVector(item))) c.lookAt = *v;
+                } else if (n == "sky") {
+                    if ((v = wantVector(item))) c.sky = *v;
+                } else if (n == "angle") {
+                    if (auto a = wantScalar(item)) {
+                        if (!(*a > 0 && *a < 180)) {
+                            error(
+                                item.nameTok,
+                                fmt::format(
+                                    "the camera angle must be between 0 and 180 degrees, found {}",
+                                    *a));
+                            ok = false;
+                        } else {
+                            c.angle = *a;
+                        }
                     }
+                } else {
+                    return false;
                 }
-            } else {
-                return false;
-            }
-            return true;
-        });
+                return true;
+            });
         if (!ok) return;
         const Vec3 dir = c.lookAt - c.location;
         if (length(dir) == 0)
             error(s.tok, "the camera's location and look_at are the same point");
-        else if (length(c.sky) == 0 || length(cross(dir, c.sky)) <= 1e-12 * length(dir) * length(c.sky))
+        else if (length(c.sky) == 0 ||
+                 length(cross(dir, c.sky)) <= 1e-12 * length(dir) * length(c.sky))
             error(s.tok, "the camera's sky vector is zero or parallel to its viewing direction");
     }
 
@@ -314,14 +351,16 @@ private:
         const std::string_view name = text(s.nameTok);
         if (name == "default") {
             if (defaultMaterialSeen_ != kNoNode) {
-                error(s.nameTok, fmt::format("material 'default' is already given at line {}", line(defaultMaterialSeen_)));
+                error(s.nameTok, fmt::format("material 'default' is already given at line {}",
+                                             line(defaultMaterialSeen_)));
                 return;
             }
             defaultMaterialSeen_ = s.nameTok;
             materialIndex_[s.nameTok] = 0;
             return;
         }
-        auto [it, inserted] = materialByName_.emplace(name, static_cast<uint32_t>(g_.materials.size()));
+        auto [it, inserted] =
+            materialByName_.emplace(name, static_cast<uint32_t>(g_.materials.size()));
         if (!inserted) {
             error(s.nameTok, fmt::format("material '{}' is already defined at line {}", clip(name),
                                          line(materialTok_[it->second])));
@@ -360,12 +399,12 @@ private:
 
     struct ModuleInfo {
         std::string_view name;
-        uint32_t firstTok;          // where it first appears
-        uint32_t decl = kNoNode;    // notation A: the declaration statement
+        uint32_t firstTok;        // where it first appears
+        uint32_t decl = kNoNode;  // notation A: the declaration statement
         bool notationB = false;
         bool hasRules = false;
-        std::vector<uint32_t> rules;  // statement indices, in file order
-        std::vector<uint32_t> formals;  // notation B: token indices of the first rule's formals
+        std::vector<uint32_t> rules;     // statement indices, in file order
+        std::vector<uint32_t> formals;   // notation B: token indices of the first rule's formals
         uint32_t formalsRule = kNoNode;  // the rule statement they come from
         std::vector<Slot> formalSlots;
         NodeId node = kNone;
@@ -390,15 +429,17 @@ private:
                 case StmtKind::Module: {
                     ModuleInfo& m = modules_[moduleFor(s.nameTok)];
                     if (m.decl != kNoNode) {
-                        error(s.nameTok, fmt::format("module {} is already declared at line {}", clip(m.name),
-                                                     line(ast_.stmts[m.decl].nameTok)));
+                        error(s.nameTok,
+                              fmt::format("module {} is already declared at line {}", clip(m.name),
+                                          line(ast_.stmts[m.decl].nameTok)));
                     } else if (m.notationB) {
-                        error(s.nameTok, fmt::format("module {} has notation-B rules (line {}), which "
-                                                     "select by their conditions: it cannot also have a "
-                                                     "selection function (to start from {}, write the "
-                                                     "axiom with a label: 'w: {}(...)')",
-                                                     clip(m.name), line(ast_.stmts[m.rules[0]].nameTok),
-                                                     clip(m.name), clip(m.name)));
+                        error(s.nameTok,
+                              fmt::format("module {} has notation-B rules (line {}), which "
+                                          "select by their conditions: it cannot also have a "
+                                          "selection function (to start from {}, write the "
+                                          "axiom with a label: 'w: {}(...)')",
+                                          clip(m.name), line(ast_.stmts[m.rules[0]].nameTok),
+                                          clip(m.name), clip(m.name)));
                     } else {
                         m.decl = si;
                     }
@@ -407,9 +448,10 @@ private:
                 case StmtKind::RuleA: {
                     ModuleInfo& m = modules_[moduleFor(s.nameTok)];
                     if (m.notationB) {
-                        error(s.tok, fmt::format("module {} uses notation B (rule at line {}); one module "
-                                                 "uses one notation",
-                                                 clip(m.name), line(ast_.stmts[m.rules[0]].tok)));
+                        error(s.tok,
+                              fmt::format("module {} uses notation B (rule at line {}); one module "
+                                          "uses one notation",
+                                          clip(m.name), line(ast_.stmts[m.rules[0]].tok)));
                         break;
                     }
                     m.hasRules = true;
@@ -419,10 +461,12 @@ private:
                 case StmtKind::RuleB: {
                     ModuleInfo& m = modules_[moduleFor(s.nameTok)];
                     if (m.decl != kNoNode || (m.hasRules && !m.notationB)) {
-                        const uint32_t where = m.decl != kNoNode ? ast_.stmts[m.decl].tok : ast_.stmts[m.rules[0]].tok;
-                        error(s.tok, fmt::format("module {} uses notation A (line {}); one module uses "
-                                                 "one notation",
-                                                 clip(m.name), line(where)));
+                        const uint32_t where =
+                            m.decl != kNoNode ? ast_.stmts[m.decl].tok : ast_.stmts[m.rules[0]].tok;
+                        error(s.tok,
+                              fmt::format("module {} uses notation A (line {}); one module uses "
+                                          "one notation",
+                                          clip(m.name), line(where)));
                         break;
                     }
                     formals(m, si);
@@ -435,18 +479,21 @@ private:
                     const std::string_view name = text(s.nameTok);
                     auto [it, inserted] = definitionByName_.emplace(name, si);
                     if (!inserted)
-                        error(s.nameTok, fmt::format("'{}' is already defined at line {}", clip(name),
-                                                     line(ast_.stmts[it->second].nameTok)));
+                        error(s.nameTok,
+                              fmt::format("'{}' is already defined at line {}", clip(name),
+                                          line(ast_.stmts[it->second].nameTok)));
                     break;
                 }
-                default: break;
+                default:
+                    break;
             }
         }
         for (ModuleInfo& m : modules_) {
             if (definitionByName_.count(m.name)) {
                 const Stmt& d = ast_.stmts[definitionByName_.at(m.name)];
-                error(d.nameTok, fmt::format("'{}' is a module (line {}) and cannot also be a definition",
-                                             clip(m.name), line(m.firstTok)));
+                error(d.nameTok,
+                      fmt::format("'{}' is a module (line {}) and cannot also be a definition",
+                                  clip(m.name), line(m.firstTok)));
             }
             if (m.notationB || dropped(m.name)) continue;
             if (m.decl == kNoNode) {
@@ -457,7 +504,8 @@ private:
                 continue;
             }
             if (m.rules.empty()) {
-                error(ast_.stmts[m.decl].nameTok, fmt::format("module {} has no rules", clip(m.name)));
+                error(ast_.stmts[m.decl].nameTok,
+                      fmt::format("module {} has no rules", clip(m.name)));
                 continue;
             }
             // Rules 1..n, each exactly once; the S-node's children in rule order.
@@ -469,8 +517,9 @@ private:
                 const Stmt& a = ast_.stmts[m.rules[i - 1]];
                 const Stmt& b = ast_.stmts[m.rules[i]];
                 if (a.number == b.number) {
-                    error(b.labelTok, fmt::format("rule {} of module {} is already given at line {}",
-                                                  b.number, clip(m.name), line(a.labelTok)));
+                    error(b.labelTok,
+                          fmt::format("rule {} of module {} is already given at line {}", b.number,
+                                      clip(m.name), line(a.labelTok)));
                     ok = false;
                 }
             }
@@ -478,9 +527,10 @@ private:
             for (size_t i = 0; i < m.rules.size(); ++i) {
                 const Stmt& r = ast_.stmts[m.rules[i]];
                 if (r.number != i + 1) {
-                    error(r.labelTok, fmt::format("module {} has no rule {}: its rules must be numbered "
-                                                  "1 to {} without gaps",
-                                                  clip(m.name), i + 1, m.rules.size()));
+                    error(r.labelTok,
+                          fmt::format("module {} has no rule {}: its rules must be numbered "
+                                      "1 to {} without gaps",
+                                      clip(m.name), i + 1, m.rules.size()));
                     break;
                 }
             }
@@ -490,11 +540,13 @@ private:
     // Notation B: every rule of a module lists the same formal parameters.
     void formals(ModuleInfo& m, uint32_t si) {
         const Stmt& s = ast_.stmts[si];
-        std::vector<uint32_t> mine(ast_.lists.begin() + s.first, ast_.lists.begin() + s.first + s.count);
+        std::vector<uint32_t> mine(ast_.lists.begin() + s.first,
+                                   ast_.lists.begin() + s.first + s.count);
         for (size_t i = 0; i < mine.size(); ++i)
             for (size_t j = 0; j < i; ++j)
                 if (text(mine[i]) == text(mine[j]))
-                    error(mine[i], fmt::format("parameter '{}' is listed twice", clip(text(mine[i]))));
+                    error(mine[i],
+                          fmt::format("parameter '{}' is listed twice", clip(text(mine[i]))));
         if (m.formalsRule == kNoNode) {
             m.formals = mine;
             m.formalsRule = si;
@@ -503,10 +555,11 @@ private:
         bool same = m.formals.size() == mine.size();
         for (size_t i = 0; same && i < mine.size(); ++i) same = text(mine[i]) == text(m.formals[i]);
         if (!same)
-            error(s.nameTok, fmt::format("rule '{}' gives module {} the parameters ({}), but its rule at "
-                                         "line {} gives ({})",
-                                         clip(text(s.labelTok)), clip(m.name), formalList(mine), line(ast_.stmts[m.formalsRule].tok),
-                                         formalList(m.formals)));
+            error(s.nameTok,
+                  fmt::format("rule '{}' gives module {} the parameters ({}), but its rule at "
+                              "line {} gives ({})",
+                              clip(text(s.labelTok)), clip(m.name), formalList(mine),
+                              line(ast_.stmts[m.formalsRule].tok), formalList(m.formals)));
     }
 
     std::string formalList(const std::vector<uint32_t>& toks) const {
@@ -525,8 +578,9 @@ private:
                 axiom_ = &s;
                 continue;
             }
-            error(s.tok, fmt::format("a second axiom (the first is at line {}): a file has exactly one",
-                                     line(axiom_->tok)));
+            error(s.tok,
+                  fmt::format("a second axiom (the first is at line {}): a file has exactly one",
+                              line(axiom_->tok)));
         }
         if (!axiom_ && ast_.dropped == 0)
             diags_.error(FileLoc{src_.file(), 1, 1},
@@ -544,11 +598,14 @@ private:
             case CsgKind::Union:
             case CsgKind::Intersection:
             case CsgKind::Difference:
-                for (uint32_t i = 0; i < n.count; ++i) namedDefinitions(ast_.lists[n.first + i], out);
+                for (uint32_t i = 0; i < n.count; ++i)
+                    namedDefinitions(ast_.lists[n.first + i], out);
                 break;
             case CsgKind::Transform:
             case CsgKind::Calc:
-            case CsgKind::Paint: namedDefinitions(n.child, out); break;
+            case CsgKind::Paint:
+                namedDefinitions(n.child, out);
+                break;
             case CsgKind::Name: {
                 const std::string_view name = text(n.nameTok);
                 if (moduleByName_.count(name)) break;
@@ -556,7 +613,8 @@ private:
                 if (it != definitionByName_.end()) out.push_back(it->second);
                 break;
             }
-            default: break;
+            default:
+                break;
         }
     }
 
@@ -596,13 +654,16 @@ private:
                     std::string path;
                     size_t k = 0;
                     while (stack[k].stmt != d) ++k;
-                    for (size_t j = k; j < stack.size(); ++j) path += fmt::format("{} -> ", clip(text(ast_.stmts[stack[j].stmt].nameTok)));
+                    for (size_t j = k; j < stack.size(); ++j)
+                        path +=
+                            fmt::format("{} -> ", clip(text(ast_.stmts[stack[j].stmt].nameTok)));
                     path += text(ast_.stmts[d].nameTok);
                     if (!cyclic_.count(d)) {
                         error(ast_.stmts[d].nameTok,
-                              fmt::format("definition '{}' refers to itself ({}): only a module can be "
-                                          "recursive",
-                                          clip(text(ast_.stmts[d].nameTok)), path));
+                              fmt::format(
+                                  "definition '{}' refers to itself ({}): only a module can be "
+                                  "recursive",
+                                  clip(text(ast_.stmts[d].nameTok)), path));
                     }
                     for (size_t j = k; j < stack.size(); ++j) cyclic_.insert(stack[j].stmt);
                     continue;
@@ -623,7 +684,8 @@ private:
             mod.notationB = m.notationB;
             mod.loc = loc(m.decl != kNoNode ? ast_.stmts[m.decl].nameTok : m.firstTok);
             const uint32_t index = static_cast<uint32_t>(g_.modules.size());
-            m.node = g_.addNode(NodeKind::Select, index, std::vector<NodeId>(m.rules.size(), kNone), mod.loc);
+            m.node = g_.addNode(NodeKind::Select, index, std::vector<NodeId>(m.rules.size(), kNone),
+                                mod.loc);
             mod.node = m.node;
             for (uint32_t f : m.formals) {
                 m.formalSlots.push_back(slotOf(text(f)));
@@ -677,7 +739,8 @@ private:
             Primitive p;
             p.kind = PrimitiveKind::Empty;
             g_.primitives.push_back(p);
-            placeholder_ = g_.addNode(NodeKind::Primitive, static_cast<uint32_t>(g_.primitives.size() - 1), {});
+            placeholder_ = g_.addNode(NodeKind::Primitive,
+                                      static_cast<uint32_t>(g_.primitives.size() - 1), {});
         }
         return placeholder_;
     }
@@ -691,13 +754,15 @@ private:
             case CsgKind::Difference: {
                 std::vector<NodeId> children;
                 children.reserve(n.count);
-                for (uint32_t i = 0; i < n.count; ++i) children.push_back(csg(ast_.lists[n.first + i]));
+                for (uint32_t i = 0; i < n.count; ++i)
+                    children.push_back(csg(ast_.lists[n.first + i]));
                 const NodeKind kind = n.kind == CsgKind::Union          ? NodeKind::Union
                                       : n.kind == CsgKind::Intersection ? NodeKind::Intersection
                                                                         : NodeKind::Difference;
                 return g_.addNode(kind, kNone, children, where);
             }
-            case CsgKind::Transform: return transform(n);
+            case CsgKind::Transform:
+                return transform(n);
             case CsgKind::Calc: {
                 const NodeId child = csg(n.child);
                 if (n.count == 0) return child;  // `{}` assigns nothing
@@ -714,7 +779,8 @@ private:
                 calc.first = static_cast<uint32_t>(g_.assignments.size());
                 g_.assignments.insert(g_.assignments.end(), list.begin(), list.end());
                 g_.calcs.push_back(calc);
-                return g_.addNode(NodeKind::Calc, static_cast<uint32_t>(g_.calcs.size() - 1), {child}, where);
+                return g_.addNode(NodeKind::Calc, static_cast<uint32_t>(g_.calcs.size() - 1),
+                                  {child}, where);
             }
             case CsgKind::Paint: {
                 const NodeId child = csg(n.child);
@@ -724,17 +790,22 @@ private:
                     auto it = materialByName_.find(name);
                     if (it == materialByName_.end()) {
                         if (!dropped(name))
-                            error(n.nameTok, fmt::format("unknown material '{}'{}", clip(name),
-                                                     materialByName_.empty() ? " (no material is defined)" : ""));
+                            error(n.nameTok,
+                                  fmt::format(
+                                      "unknown material '{}'{}", clip(name),
+                                      materialByName_.empty() ? " (no material is defined)" : ""));
                         return child;
                     }
                     material = it->second;
                 }
                 return g_.addNode(NodeKind::Paint, material, {child}, where);
             }
-            case CsgKind::Primitive: return primitive(n);
-            case CsgKind::Name: return name(n);
-            case CsgKind::Call: return call(n);
+            case CsgKind::Primitive:
+                return primitive(n);
+            case CsgKind::Name:
+                return name(n);
+            case CsgKind::Call:
+                return call(n);
         }
         return placeholder();
     }
@@ -750,7 +821,8 @@ private:
         }
         if (dropped(name)) return placeholder();
         if (assigned_.count(name))
-            error(n.nameTok, fmt::format("'{}' is a parameter, not a module or definition", clip(name)));
+            error(n.nameTok,
+                  fmt::format("'{}' is a parameter, not a module or definition", clip(name)));
         else
             error(n.nameTok, fmt::format("unknown module or definition '{}'", clip(name)));
         return placeholder();
@@ -769,9 +841,10 @@ private:
         }
         const ModuleInfo& m = modules_[it->second];
         if (!m.notationB) {
-            error(n.nameTok, fmt::format("module {} uses notation A and has no parameter list; set its "
-                                         "parameters with a C-node, as in '{{c = ...}} {}'",
-                                         clip(name), clip(name)));
+            error(n.nameTok,
+                  fmt::format("module {} uses notation A and has no parameter list; set its "
+                              "parameters with a C-node, as in '{{c = ...}} {}'",
+                              clip(name), clip(name)));
             return placeholder();
         }
         if (n.count != m.formals.size()) {
@@ -790,7 +863,8 @@ private:
         calc.simultaneous = true;
         g_.assignments.insert(g_.assignments.end(), list.begin(), list.end());
         g_.calcs.push_back(calc);
-        return g_.addNode(NodeKind::Calc, static_cast<uint32_t>(g_.calcs.size() - 1), {m.node}, loc(n.nameTok));
+        return g_.addNode(NodeKind::Calc, static_cast<uint32_t>(g_.calcs.size() - 1), {m.node},
+                          loc(n.nameTok));
     }
 
     // Compiles a list of arguments; returns whether all are constant and finite, with
@@ -817,7 +891,8 @@ private:
         const TransformInfo info = transformInfo(n.op);
         const NodeId child = csg(n.child);
         if (n.count != info.args) {
-            error(n.tok, fmt::format("{} takes {} ({}), found {}", clip(text(n.tok)), argumentCount(info.args), info.names, n.count));
+            error(n.tok, fmt::format("{} takes {} ({}), found {}", clip(text(n.tok)),
+                                     argumentCount(info.args), info.names, n.count));
             return child;
         }
         Transform tr;
@@ -832,7 +907,8 @@ private:
             }
         }
         g_.transforms.push_back(tr);
-        return g_.addNode(NodeKind::Transform, static_cast<uint32_t>(g_.transforms.size() - 1), {child}, loc(n.tok));
+        return g_.addNode(NodeKind::Transform, static_cast<uint32_t>(g_.transforms.size() - 1),
+                          {child}, loc(n.tok));
     }
 
     NodeId primitive(const CsgNode& n) {
@@ -841,8 +917,10 @@ private:
             if (want == 0)
                 error(n.tok, fmt::format("{} takes no arguments", clip(text(n.tok))));
             else
-                error(n.tok, fmt::format("{} takes {} ({}), found {}", clip(text(n.tok)), argumentCount(want),
-                                         want == 2 ? "R, r" : "x1, y1, z1, x2, y2, z2, x3, y3, z3", n.count));
+                error(n.tok, fmt::format("{} takes {} ({}), found {}", clip(text(n.tok)),
+                                         argumentCount(want),
+                                         want == 2 ? "R, r" : "x1, y1, z1, x2, y2, z2, x3, y3, z3",
+                                         n.count));
             return placeholder();
         }
         Primitive p;
@@ -852,7 +930,8 @@ private:
         p.constant = arguments(n, p.firstArg, values);
         if (p.constant) p.values = std::move(values);
         g_.primitives.push_back(std::move(p));
-        return g_.addNode(NodeKind::Primitive, static_cast<uint32_t>(g_.primitives.size() - 1), {}, loc(n.tok));
+        return g_.addNode(NodeKind::Primitive, static_cast<uint32_t>(g_.primitives.size() - 1), {},
+                          loc(n.tok));
     }
 
     // --- expressions: the stack code of graph.h ---
@@ -909,10 +988,16 @@ private:
             case ExKind::Name: {
                 const std::string_view name = text(n.tok);
                 if (constantOnly_) {
-                    error(n.tok, fmt::format("'{}': the values of a directive are constants, not parameters", clip(name)));
+                    error(
+                        n.tok,
+                        fmt::format("'{}': the values of a directive are constants, not parameters",
+                                    clip(name)));
                 } else if (!assigned_.count(name) && ast_.dropped == 0 &&
                            reportedUnknown_.insert(name).second) {
-                    error(n.tok, fmt::format("unknown parameter '{}': no C-node or formal parameter assigns it", clip(name)));
+                    error(n.tok,
+                          fmt::format(
+                              "unknown parameter '{}': no C-node or formal parameter assigns it",
+                              clip(name)));
                 }
                 emit(Op::Load, slotOf(name));
                 cg.readsSlot = true;
@@ -921,8 +1006,10 @@ private:
             }
             case ExKind::Unary:
                 gen(n.a, cg);
-                if (n.op == Tok::Minus) emit(Op::Neg);
-                else if (n.op == Tok::Bang) emit(Op::Not);
+                if (n.op == Tok::Minus)
+                    emit(Op::Neg);
+                else if (n.op == Tok::Bang)
+                    emit(Op::Not);
                 return;
             case ExKind::Power:
                 gen(n.a, cg);
@@ -930,8 +1017,10 @@ private:
                 emit(Op::Pow);
                 cg.pop();
                 return;
-            case ExKind::Chain: return chain(n, cg);
-            case ExKind::Call: return call(n, cg);
+            case ExKind::Chain:
+                return chain(n, cg);
+            case ExKind::Call:
+                return call(n, cg);
         }
     }
 
@@ -978,18 +1067,41 @@ private:
             gen(items[i].operand, cg);
             Op op = Op::Add;
             switch (items[i].op) {
-                case Tok::Plus: op = Op::Add; break;
-                case Tok::Minus: op = Op::Sub; break;
-                case Tok::Star: op = Op::Mul; break;
-                case Tok::Slash: op = Op::Div; break;
-                case Tok::Percent: op = Op::Mod; break;
-                case Tok::Lt: op = Op::Lt; break;
-                case Tok::Le: op = Op::Le; break;
-                case Tok::Gt: op = Op::Gt; break;
-                case Tok::Ge: op = Op::Ge; break;
-                case Tok::Eq: op = Op::Eq; break;
-                case Tok::Ne: op = Op::Ne; break;
-                default: break;
+                case Tok::Plus:
+                    op = Op::Add;
+                    break;
+                case Tok::Minus:
+                    op = Op::Sub;
+                    break;
+                case Tok::Star:
+                    op = Op::Mul;
+                    break;
+                case Tok::Slash:
+                    op = Op::Div;
+                    break;
+                case Tok::Percent:
+                    op = Op::Mod;
+                    break;
+                case Tok::Lt:
+                    op = Op::Lt;
+                    break;
+                case Tok::Le:
+                    op = Op::Le;
+                    break;
+                case Tok::Gt:
+                    op = Op::Gt;
+                    break;
+                case Tok::Ge:
+                    op = Op::Ge;
+                    break;
+                case Tok::Eq:
+                    op = Op::Eq;
+                    break;
+                case Tok::Ne:
+                    op = Op::Ne;
+                    break;
+                default:
+                    break;
             }
             emit(op);
             cg.pop();
@@ -1028,7 +1140,8 @@ private:
             }
             case Kw::Rand:
                 if (n.count == 0) {
-                    if (constantOnly_) error(n.tok, "rand() depends on the instance: it is not a constant");
+                    if (constantOnly_)
+                        error(n.tok, "rand() depends on the instance: it is not a constant");
                     emit(Op::Rand0, g_.randCallSites++);
                     cg.usesPath = true;
                     cg.push();
@@ -1040,14 +1153,16 @@ private:
                 return;
             case Kw::Choose: {
                 if (n.count < 1 || n.count > 255) return wrongCount("1 to 255 weights");
-                if (constantOnly_) error(n.tok, "choose() depends on the instance: it is not a constant");
+                if (constantOnly_)
+                    error(n.tok, "choose() depends on the instance: it is not a constant");
                 for (uint32_t i = 0; i < n.count; ++i) gen(args[i], cg);
                 emit(Op::Choose, g_.randCallSites++, 0, static_cast<uint8_t>(n.count));
                 cg.usesPath = true;
                 cg.pop(n.count - 1);
                 return;
             }
-            default: break;
+            default:
+                break;
         }
         const FuncInfo* info = functionInfo(f.kw);
         if (!info) {
@@ -1057,8 +1172,7 @@ private:
             return;
         }
         if (n.count < info->minArgs || n.count > info->maxArgs) {
-            if (info->maxArgs == 255)
-                return wrongCount(fmt::format("2 to 255 arguments"));
+            if (info->maxArgs == 255) return wrongCount(fmt::format("2 to 255 arguments"));
             return wrongCount(argumentCount(info->minArgs));
         }
         for (uint32_t i = 0; i < n.count; ++i) gen(args[i], cg);
@@ -1111,11 +1225,13 @@ private:
                 const NodeId c = g_.child(i, k);
                 if (c >= count || source[c] == kNone) continue;
                 const Node& tri = g_.nodes[source[c]];
-                diags_.error(n.loc, fmt::format("a triangle ({} at line {}) is reachable as an operand of "
-                                                "this {}: triangles are surfaces without an inside, "
-                                                "so only '∪' may combine them",
-                                                primitiveName(g_.primitives[tri.payload].kind), tri.loc.line,
-                                                n.kind == NodeKind::Intersection ? "intersection" : "difference"));
+                diags_.error(
+                    n.loc,
+                    fmt::format("a triangle ({} at line {}) is reachable as an operand of "
+                                "this {}: triangles are surfaces without an inside, "
+                                "so only '∪' may combine them",
+                                primitiveName(g_.primitives[tri.payload].kind), tri.loc.line,
+                                n.kind == NodeKind::Intersection ? "intersection" : "difference"));
                 break;
             }
         }
@@ -1123,9 +1239,12 @@ private:
 
     static const char* primitiveName(PrimitiveKind k) {
         switch (k) {
-            case PrimitiveKind::Tri1: return "tri1";
-            case PrimitiveKind::Tri2: return "tri2";
-            default: return "triangle";
+            case PrimitiveKind::Tri1:
+                return "tri1";
+            case PrimitiveKind::Tri2:
+                return "tri2";
+            default:
+                return "triangle";
         }
     }
 

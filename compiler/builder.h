@@ -1,4 +1,4 @@
-// The builder: AST -> Graph (LANGUAGE.md sections 2-7).
+// The builder: AST -> Graph (docs/language.md sections 2-7).
 //
 // First the checks that need the whole file: modules declared and their rules numbered
 // 1..n exactly once, one notation per module, names that resolve, parameters that some

@@ -2,14 +2,13 @@
 // and by walking it with the shared evaluation code exactly as the renderers do.
 #include "builder.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "compile_test_util.h"
 #include "compiler.h"
@@ -51,7 +50,8 @@ void walk(const Graph& g, NodeId n, const std::vector<double>& frame, uint64_t p
             return;
         }
         case NodeKind::Transform:
-            walk(g, g.child(n), frame, path, depth, world * transformMatrix(g, n, s), material, out);
+            walk(g, g.child(n), frame, path, depth, world * transformMatrix(g, n, s), material,
+                 out);
             return;
         case NodeKind::Paint:
             walk(g, g.child(n), frame, path, depth, world, node.payload, out);
@@ -65,7 +65,9 @@ void walk(const Graph& g, NodeId n, const std::vector<double>& frame, uint64_t p
         case NodeKind::Primitive: {
             const Primitive& p = g.primitives[node.payload];
             Leaf leaf{p.kind, world, material, frame, {}};
-            leaf.args.resize(p.kind == PrimitiveKind::Torus ? 2 : p.kind == PrimitiveKind::Triangle ? 9 : 0);
+            leaf.args.resize(p.kind == PrimitiveKind::Torus      ? 2
+                             : p.kind == PrimitiveKind::Triangle ? 9
+                                                                 : 0);
             primitiveArgs(g, n, s, leaf.args.data());
             out.push_back(std::move(leaf));
             return;
@@ -104,15 +106,17 @@ std::vector<std::vector<long>> positions(const std::vector<Leaf>& ls) {
     return out;
 }
 
-// --- the paper's systems (LANGUAGE.md: figures 2, 3a, 5a, 6, 8) ---
+// --- the paper's systems (docs/language.md: figures 2, 3a, 5a, 6, 8) ---
 
 const char* kFigure2 =
     "w:S(4)\t// the axiom\n"
     "p1:S(c) : c=0 → tetrahedron\t// terminating rule\n"
-    "p2:S(c) : c>0 → move(0.5,0.5,0.5) uscale(0.5) S(c-1) ∪ move(-0.5,-0.5,0.5) uscale(0.5) S(c-1) ∪ "
-    "move(0.5,-0.5,-0.5) uscale(0.5) S(c-1) ∪ move(-0.5,0.5,-0.5) uscale(0.5) S(c-1)\t// generating rule\n";
+    "p2:S(c) : c>0 → move(0.5,0.5,0.5) uscale(0.5) S(c-1) ∪ move(-0.5,-0.5,0.5) uscale(0.5) S(c-1) "
+    "∪ "
+    "move(0.5,-0.5,-0.5) uscale(0.5) S(c-1) ∪ move(-0.5,0.5,-0.5) uscale(0.5) S(c-1)\t// "
+    "generating rule\n";
 
-// Figure 3a with LANGUAGE.md's parentheses.
+// Figure 3a with docs/language.md's parentheses.
 const char* kFigure3a =
     "{c=4} S // definition of the start node and initialization of c\n"
     "S if(c > 0,2,1) // declaration of the module S and its selection function\n"
@@ -168,19 +172,26 @@ TEST(Figures, Figure5aWithTheLeafOfFigure6) {
         "\n"
         "TR   if(trunk > 0, 2, if(cnt > 0, 3, 1))           // module for the tree\n"
         "1: TR → SG                                         // terminating rule\n"
-        "2: TR → SG ∪ {trunk=trunk-1} move(0,0,1) uscale(fTR) TR // rule for the generation of the trunk\n"
-        "                                           // rule for the generation of the branching structure\n"
+        "2: TR → SG ∪ {trunk=trunk-1} move(0,0,1) uscale(fTR) TR // rule for the generation of the "
+        "trunk\n"
+        "                                           // rule for the generation of the branching "
+        "structure\n"
         "3: TR → SG ∪ move(0,0,1) rotz(gamma)({cnt=cnt-1} rotx(alpha1) uscale(fBR1) TR ∪\n"
         "                                           {cnt=cnt-1} rotx(alpha2) uscale(fBR2) TR )\n"
         "SG   if(cnt < noleaves, if(segments > 0, 3, 2), 1) // module for segments\n"
-        "1: SG → scale(fxSG,fySG,1) cylinder                // this rule is selected for limbs without leaves\n"
-        "2: SG → segment                                    // terminating rule for limbs with leaves\n"
-        "3: SG → segment ∪ {segments=segments-1} move(0,0,dSG) rotz(-90) SG // generating rule for limbs with leaves\n"
+        "1: SG → scale(fxSG,fySG,1) cylinder                // this rule is selected for limbs "
+        "without leaves\n"
+        "2: SG → segment                                    // terminating rule for limbs with "
+        "leaves\n"
+        "3: SG → segment ∪ {segments=segments-1} move(0,0,dSG) rotz(-90) SG // generating rule for "
+        "limbs with leaves\n"
         "                                           // CSG expression for segments with leaves\n"
-        "segment = scale(fxSG,fySG,dSG) cylinder ∪ move(0,0,dSG) (uscale( fLV) leaf ∪ flipxz uscale(fLV) leaf)\n"
+        "segment = scale(fxSG,fySG,dSG) cylinder ∪ move(0,0,dSG) (uscale( fLV) leaf ∪ flipxz "
+        "uscale(fLV) leaf)\n"
         "\n"
         "connected_balls = (move(-D,0,0) sphere  ∪  move(D,0,0) sphere) \\\n"
-        "                  (move(-D,0,0) uscale(1-thickness) sphere  ∪  move(D,0,0) uscale(1-thickness) sphere)\n"
+        "                  (move(-D,0,0) uscale(1-thickness) sphere  ∪  move(D,0,0) "
+        "uscale(1-thickness) sphere)\n"
         "leaf = move(0, dy, dz) scale(fx, fy, fz) cylinder  ∩  connected_balls\n";
     auto c = compile(text);
     ASSERT_TRUE(c->graph) << c->errors();
@@ -260,14 +271,16 @@ TEST(Figures, Figure8WithItsMacrosWrittenOut) {
         "       } move(1,1,0) T2\n"
         "\n"
         "T1  if(cnt > 0, 2, 1) // triangle on the upper right part of the xy-plane\n"
-        "1:T1 → calc_TRI1 move(0,0,z1) zshear(z2-z1,z3-z1) tri1 // terminating rule for triangle T1\n"
+        "1:T1 → calc_TRI1 move(0,0,z1) zshear(z2-z1,z3-z1) tri1 // terminating rule for triangle "
+        "T1\n"
         "2:T1 → calcT1_1 scale(0.5,0.5,1) T1 ∪ // subdivision of triangle T2\n"
         "       calcT1_2 move(0.5,0,0) scale(0.5,0.5,1) T1 ∪\n"
         "       calcT1_3 move(0,0.5,0) scale(0.5,0.5,1) T1 ∪\n"
         "       calcT1_4 move(0.5,0.5,0) scale(0.5,0.5,1) T2\n"
         "\n"
         "T2  if(cnt > 0, 2, 1) // triangle on the lower left part of the xy-plane\n"
-        "1:T2 → calc_TRI2 move(0,0,z1) zshear(z1-z2,z1-z3) tri2 // terminating rule for triangle T2\n"
+        "1:T2 → calc_TRI2 move(0,0,z1) zshear(z1-z2,z1-z3) tri2 // terminating rule for triangle "
+        "T2\n"
         "2:T2 → calcT2_1 scale(0.5,0.5,1) T2 ∪ // subdivision of triangle T2\n"
         "       calcT2_2 move(-0.5,0,0) scale(0.5,0.5,1) T2 ∪\n"
         "       calcT2_3 move(0,-0.5,0) scale(0.5,0.5,1) T2 ∪\n"
@@ -352,9 +365,11 @@ TEST(Definitions, AreBuiltOnceAndShared) {
 TEST(Definitions, MayNotReferToThemselvesButModulesMay) {
     auto bad = compile("a = sphere ∪ b\nb = move(1,0,0) a\na");
     EXPECT_FALSE(bad->graph);
-    EXPECT_NE(bad->errors().find("definition 'a' refers to itself (a -> b -> a)"), std::string::npos)
+    EXPECT_NE(bad->errors().find("definition 'a' refers to itself (a -> b -> a)"),
+              std::string::npos)
         << bad->errors();
-    auto ok = compile("a = sphere ∪ {n = n - 1} S\nS if(n > 0, 2, 1)\n1: S -> cube\n2: S -> a\n{n = 2} S");
+    auto ok = compile(
+        "a = sphere ∪ {n = n - 1} S\nS if(n > 0, 2, 1)\n1: S -> cube\n2: S -> a\n{n = 2} S");
     ASSERT_TRUE(ok->graph) << ok->errors();
     EXPECT_EQ(leaves(*ok->graph).size(), 3u);
 }
@@ -370,13 +385,16 @@ TEST(Definitions, ALongChainDoesNotRecurse) {
 }
 
 TEST(Transforms, ConstantOnesAreFoldedAndOthersKeepTheirArguments) {
-    auto c = compile("{s = 2} (rot(0,0,1,90) sphere ∪ uscale(s) cube ∪ uscale(0) cone ∪ matrix(1,0,0, 0,1,0, 0,0,1, 1,2,3) plane)");
+    auto c = compile(
+        "{s = 2} (rot(0,0,1,90) sphere ∪ uscale(s) cube ∪ uscale(0) cone ∪ matrix(1,0,0, 0,1,0, "
+        "0,0,1, 1,2,3) plane)");
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
     ASSERT_EQ(g.transforms.size(), 4u);
     EXPECT_TRUE(g.transforms[0].constant);
     const double ninety = 90;
-    EXPECT_EQ(g.transforms[0].matrix, makeTransform(TransformOp::Rot, std::vector<double>{0, 0, 1, ninety}.data()));
+    EXPECT_EQ(g.transforms[0].matrix,
+              makeTransform(TransformOp::Rot, std::vector<double>{0, 0, 1, ninety}.data()));
     EXPECT_FALSE(g.transforms[1].constant);
     EXPECT_EQ(g.transforms[1].argCount, 1u);
     EXPECT_FALSE(g.exprs[g.args[g.transforms[1].firstArg]].constant);
@@ -403,8 +421,9 @@ TEST(Primitives, ArgumentsAreFoldedWhenConstant) {
 }
 
 TEST(Paint, MaterialsAreIndexedAndTheInnermostWins) {
-    auto c = compile("material red { color <1,0,0> }\nmaterial blue { color <0,0,1> phong 0.5 }\n"
-                     "paint(red) (sphere ∪ paint(blue) cube ∪ paint(default) cone)");
+    auto c = compile(
+        "material red { color <1,0,0> }\nmaterial blue { color <0,0,1> phong 0.5 }\n"
+        "paint(red) (sphere ∪ paint(blue) cube ∪ paint(default) cone)");
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
     ASSERT_EQ(g.materials.size(), 3u);
@@ -425,7 +444,8 @@ TEST(Directives, FillTheSceneAndTheMaterials) {
         "light  { position <10,-20,30>  color <1,1,1> }\n"
         "light  { position <-1,0,5>; color <0.5, 0.5, 0.5> }\n"
         "background <0.55, 0.7, 0.9>\n"
-        "material bark { color <0.35,0.22,0.1>  ambient 0.1  diffuse 0.7  phong 0.2  phong_size 30  reflection 0 }\n"
+        "material bark { color <0.35,0.22,0.1>  ambient 0.1  diffuse 0.7  phong 0.2  phong_size 30 "
+        " reflection 0 }\n"
         "material default { color <0.5,0.5,0.5> }\n"
         "settings { seed 7  max_depth 100 }\n"
         "paint(bark) sphere\n");
@@ -479,19 +499,24 @@ TEST(Checks, TrianglesUnderIntersectionsAndDifferencesAreFound) {
                              "S 1\n1: S -> T\nT 1\n1: T -> tri2\nS ∩ cube"}) {
         auto c = compile(text);
         EXPECT_FALSE(c->graph) << text;
-        EXPECT_NE(c->errors().find("is reachable as an operand of this"), std::string::npos) << text << c->errors();
+        EXPECT_NE(c->errors().find("is reachable as an operand of this"), std::string::npos)
+            << text << c->errors();
     }
 }
 
 TEST(Checks, ExactlyOneAxiom) {
-    EXPECT_NE(compile("d = sphere")->errors().find("1:1: error: the file has no axiom"), std::string::npos);
-    EXPECT_NE(compile("sphere\ncube")->errors().find("2:1: error: a second axiom (the first is at line 1)"),
+    EXPECT_NE(compile("d = sphere")->errors().find("1:1: error: the file has no axiom"),
+              std::string::npos);
+    EXPECT_NE(compile("sphere\ncube")
+                  ->errors()
+                  .find("2:1: error: a second axiom (the first is at line 1)"),
               std::string::npos);
 }
 
 TEST(Checks, ParametersMustBeAssignedSomewhere) {
     auto c = compile("S if(depth > 0, 1, 1)\n1: S -> sphere\nS");
-    EXPECT_NE(c->errors().find("1:6: error: unknown parameter 'depth'"), std::string::npos) << c->errors();
+    EXPECT_NE(c->errors().find("1:6: error: unknown parameter 'depth'"), std::string::npos)
+        << c->errors();
     // Assigned anywhere in the file is enough at compile time.
     EXPECT_TRUE(compile("S if(depth > 0, 1, 1)\n1: S -> sphere\n{depth = 1} S")->graph);
     EXPECT_TRUE(compile("p: S(depth) : depth > 0 -> sphere\nw: S(1)")->graph);

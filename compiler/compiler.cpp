@@ -1,12 +1,12 @@
 // compileSource and compileFile: the three phases in a row. See compiler.h.
 #include "compiler.h"
 
+#include <fmt/format.h>
+
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-
-#include <fmt/format.h>
 
 #include "builder.h"
 #include "fold_constants.h"
@@ -29,8 +29,9 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
     const TokenStream tokens = lex(src, diags);
     if (!tokens.complete) return std::nullopt;  // the rest of the file was not read
     if (diags.count() == errorsBefore && tokens.tokens.size() == 1) {
-        diags.error(FileLoc{file, 1, 1}, "the file is empty: a scene needs at least an axiom, "
-                                         "such as 'sphere'");
+        diags.error(FileLoc{file, 1, 1},
+                    "the file is empty: a scene needs at least an axiom, "
+                    "such as 'sphere'");
         return std::nullopt;
     }
     const Ast ast = parse(src, tokens, diags);

@@ -26,7 +26,6 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
 
 // Reads and compiles a file. An unreadable file is a diagnostic too. The file's text is
 // kept alive by `diags`' owner through `storage`.
-std::optional<Graph> compileFile(const std::string& path, std::string& storage,
-                                 Diagnostics& diags);
+std::optional<Graph> compileFile(const std::string& path, std::string& storage, Diagnostics& diags);
 
 }  // namespace pcsg

@@ -1,4 +1,4 @@
-// Compile-time diagnostics, printed like a C compiler's (LANGUAGE.md section 8):
+// Compile-time diagnostics, printed like a C compiler's (docs/language.md section 8):
 //
 //   scene.pcsg:3:14: error: unknown function 'sine'
 //     S if(sine(c) > 0, 2, 1)
@@ -19,7 +19,7 @@ struct Diagnostic {
 };
 
 class Diagnostics {
-public:
+  public:
     // Registers a source text under a name; returns the file index for FileLoc::file.
     uint32_t addFile(std::string name, std::string_view text);
 
@@ -39,7 +39,7 @@ public:
     // Stops collecting after this many errors (the last one says so).
     static constexpr size_t kMaxErrors = 50;
 
-private:
+  private:
     std::vector<std::string> names_;
     std::vector<std::string_view> texts_;
     std::vector<Diagnostic> errors_;

@@ -9,7 +9,8 @@
 namespace pcsg {
 namespace {
 
-std::string formatOne(std::string_view text, uint32_t line, uint32_t column, const std::string& msg) {
+std::string formatOne(std::string_view text, uint32_t line, uint32_t column,
+                      const std::string& msg) {
     Diagnostics d;
     const uint32_t f = d.addFile("a.pcsg", text);
     d.error({f, line, column}, msg);
@@ -24,7 +25,8 @@ TEST(DiagnosticsFormat, HeaderSourceLineAndCaret) {
 }
 
 TEST(DiagnosticsFormat, TabsAreKeptSoTheCaretLinesUp) {
-    EXPECT_EQ(formatOne("\t\tx = $", 1, 7, "m"), "a.pcsg:1:7: error: m\n  \t\tx = $\n  \t\t    ^\n");
+    EXPECT_EQ(formatOne("\t\tx = $", 1, 7, "m"),
+              "a.pcsg:1:7: error: m\n  \t\tx = $\n  \t\t    ^\n");
 }
 
 TEST(DiagnosticsFormat, MultiByteCharactersTakeOneColumnOfCaret) {
@@ -33,16 +35,19 @@ TEST(DiagnosticsFormat, MultiByteCharactersTakeOneColumnOfCaret) {
 }
 
 TEST(DiagnosticsFormat, ControlBytesAndCarriageReturnsAreNotPrinted) {
-    EXPECT_EQ(formatOne(std::string("a\x01\xff b\r\nnext", 9), 1, 5, "m"), "a.pcsg:1:5: error: m\n  a?? b\n      ^\n");
+    EXPECT_EQ(formatOne(std::string("a\x01\xff b\r\nnext", 9), 1, 5, "m"),
+              "a.pcsg:1:5: error: m\n  a?? b\n      ^\n");
 }
 
 TEST(DiagnosticsFormat, ALocationPastTheEndOfTheLine) {
-    EXPECT_EQ(formatOne("move(1,0,0)\n", 1, 12, "m"), "a.pcsg:1:12: error: m\n  move(1,0,0)\n             ^\n");
+    EXPECT_EQ(formatOne("move(1,0,0)\n", 1, 12, "m"),
+              "a.pcsg:1:12: error: m\n  move(1,0,0)\n             ^\n");
     EXPECT_EQ(formatOne("", 1, 1, "empty"), "a.pcsg:1:1: error: empty\n  \n  ^\n");
 }
 
 TEST(DiagnosticsFormat, NoPositionMeansNoSourceLine) {
-    EXPECT_EQ(formatOne("x", 0, 0, "cannot open the file"), "a.pcsg: error: cannot open the file\n");
+    EXPECT_EQ(formatOne("x", 0, 0, "cannot open the file"),
+              "a.pcsg: error: cannot open the file\n");
 }
 
 TEST(DiagnosticsFormat, SeveralFilesAndErrorsInOrder) {
@@ -51,7 +56,8 @@ TEST(DiagnosticsFormat, SeveralFilesAndErrorsInOrder) {
     const uint32_t b = d.addFile("b.pcsg", "three\n");
     d.error({a, 2, 1}, "first");
     d.error({b, 1, 3}, "second");
-    EXPECT_EQ(d.format(), "a.pcsg:2:1: error: first\n  two\n  ^\nb.pcsg:1:3: error: second\n  three\n    ^\n");
+    EXPECT_EQ(d.format(),
+              "a.pcsg:2:1: error: first\n  two\n  ^\nb.pcsg:1:3: error: second\n  three\n    ^\n");
     EXPECT_EQ(d.fileNames().size(), 2u);
 }
 

@@ -2,11 +2,11 @@
 // through these functions.
 #include "eval.h"
 
+#include <fmt/format.h>
+
 #include <bit>
 #include <cmath>
 #include <cstring>
-
-#include <fmt/format.h>
 
 namespace pcsg {
 
@@ -33,8 +33,12 @@ std::string RuntimeError::format(const Graph& g) const {
     return out;
 }
 
-double unassigned() { return std::bit_cast<double>(kUnassignedBits); }
-bool isUnassigned(double v) { return std::bit_cast<uint64_t>(v) == kUnassignedBits; }
+double unassigned() {
+    return std::bit_cast<double>(kUnassignedBits);
+}
+bool isUnassigned(double v) {
+    return std::bit_cast<uint64_t>(v) == kUnassignedBits;
+}
 
 void initFrame(const Graph& g, double* frame) {
     const double u = unassigned();
@@ -66,7 +70,9 @@ constexpr uint64_t mix64(uint64_t z) {
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return z ^ (z >> 31);
 }
-constexpr double toUnit(uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
+constexpr double toUnit(uint64_t h) {
+    return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
 }  // namespace
 
 uint64_t pathChild(uint64_t path, uint32_t childIndex) {
@@ -102,7 +108,9 @@ double sinDeg(double a) {
     if (r == -90 || r == 270) return -1;
     return std::sin(a * kDegToRad);
 }
-double cosDeg(double a) { return sinDeg(a + 90.0); }
+double cosDeg(double a) {
+    return sinDeg(a + 90.0);
+}
 
 [[noreturn]] void unassignedRead(const Graph& g, const Expr& e, Slot s) {
     throw RuntimeError(e.loc, fmt::format("parameter '{}' is read before it is assigned on "
@@ -112,21 +120,36 @@ double cosDeg(double a) { return sinDeg(a + 90.0); }
 
 double callFunc(Func f, const double* a, uint32_t n, uint64_t seed) {
     switch (f) {
-        case Func::Sin: return sinDeg(a[0]);
-        case Func::Cos: return cosDeg(a[0]);
-        case Func::Tan: return sinDeg(a[0]) / cosDeg(a[0]);
-        case Func::Asin: return std::asin(a[0]) / kDegToRad;
-        case Func::Acos: return std::acos(a[0]) / kDegToRad;
-        case Func::Atan: return std::atan(a[0]) / kDegToRad;
-        case Func::Atan2: return std::atan2(a[0], a[1]) / kDegToRad;
-        case Func::Sqrt: return std::sqrt(a[0]);
-        case Func::Exp: return std::exp(a[0]);
-        case Func::Ln: return std::log(a[0]);
-        case Func::Log10: return std::log10(a[0]);
-        case Func::Pow: return std::pow(a[0], a[1]);
-        case Func::Abs: return std::fabs(a[0]);
-        case Func::Floor: return std::floor(a[0]);
-        case Func::Ceil: return std::ceil(a[0]);
+        case Func::Sin:
+            return sinDeg(a[0]);
+        case Func::Cos:
+            return cosDeg(a[0]);
+        case Func::Tan:
+            return sinDeg(a[0]) / cosDeg(a[0]);
+        case Func::Asin:
+            return std::asin(a[0]) / kDegToRad;
+        case Func::Acos:
+            return std::acos(a[0]) / kDegToRad;
+        case Func::Atan:
+            return std::atan(a[0]) / kDegToRad;
+        case Func::Atan2:
+            return std::atan2(a[0], a[1]) / kDegToRad;
+        case Func::Sqrt:
+            return std::sqrt(a[0]);
+        case Func::Exp:
+            return std::exp(a[0]);
+        case Func::Ln:
+            return std::log(a[0]);
+        case Func::Log10:
+            return std::log10(a[0]);
+        case Func::Pow:
+            return std::pow(a[0], a[1]);
+        case Func::Abs:
+            return std::fabs(a[0]);
+        case Func::Floor:
+            return std::floor(a[0]);
+        case Func::Ceil:
+            return std::ceil(a[0]);
         case Func::Min: {
             double m = a[0];
             for (uint32_t i = 1; i < n; ++i) m = std::fmin(m, a[i]);
@@ -137,9 +160,12 @@ double callFunc(Func f, const double* a, uint32_t n, uint64_t seed) {
             for (uint32_t i = 1; i < n; ++i) m = std::fmax(m, a[i]);
             return m;
         }
-        case Func::Mod: return std::fmod(a[0], a[1]);
-        case Func::Clamp: return std::fmin(std::fmax(a[0], a[1]), a[2]);
-        case Func::Rand1: return randOf(seed, a[0]);
+        case Func::Mod:
+            return std::fmod(a[0], a[1]);
+        case Func::Clamp:
+            return std::fmin(std::fmax(a[0], a[1]), a[2]);
+        case Func::Rand1:
+            return randOf(seed, a[0]);
     }
     return std::nan("");
 }
@@ -174,37 +200,47 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
     for (uint32_t pc = e.begin; pc < e.end;) {
         const Instr& in = code[pc++];
         switch (in.op) {
-            case Op::Const: stack[sp++] = in.imm; break;
+            case Op::Const:
+                stack[sp++] = in.imm;
+                break;
             case Op::Load: {
                 const double v = s.frame[in.a];
                 if (std::isnan(v) && isUnassigned(v)) unassignedRead(g, e, in.a);
                 stack[sp++] = v;
                 break;
             }
-            case Op::Neg: stack[sp - 1] = -stack[sp - 1]; break;
-            case Op::Not: stack[sp - 1] = stack[sp - 1] == 0 ? 1.0 : 0.0; break;
-            case Op::ToBool: stack[sp - 1] = stack[sp - 1] != 0 ? 1.0 : 0.0; break;
-#define PCSG_BINARY(OP, EXPR)            \
-    case Op::OP: {                       \
-        const double b = stack[--sp];    \
-        const double a = stack[sp - 1];  \
-        stack[sp - 1] = (EXPR);          \
-        break;                           \
+            case Op::Neg:
+                stack[sp - 1] = -stack[sp - 1];
+                break;
+            case Op::Not:
+                stack[sp - 1] = stack[sp - 1] == 0 ? 1.0 : 0.0;
+                break;
+            case Op::ToBool:
+                stack[sp - 1] = stack[sp - 1] != 0 ? 1.0 : 0.0;
+                break;
+#define PCSG_BINARY(OP, EXPR)           \
+    case Op::OP: {                      \
+        const double b = stack[--sp];   \
+        const double a = stack[sp - 1]; \
+        stack[sp - 1] = (EXPR);         \
+        break;                          \
     }
-            PCSG_BINARY(Add, a + b)
-            PCSG_BINARY(Sub, a - b)
-            PCSG_BINARY(Mul, a * b)
-            PCSG_BINARY(Div, a / b)
-            PCSG_BINARY(Mod, std::fmod(a, b))
-            PCSG_BINARY(Pow, std::pow(a, b))
-            PCSG_BINARY(Lt, a < b ? 1.0 : 0.0)
-            PCSG_BINARY(Le, a <= b ? 1.0 : 0.0)
-            PCSG_BINARY(Gt, a > b ? 1.0 : 0.0)
-            PCSG_BINARY(Ge, a >= b ? 1.0 : 0.0)
-            PCSG_BINARY(Eq, a == b ? 1.0 : 0.0)
-            PCSG_BINARY(Ne, a != b ? 1.0 : 0.0)
+                PCSG_BINARY(Add, a + b)
+                PCSG_BINARY(Sub, a - b)
+                PCSG_BINARY(Mul, a * b)
+                PCSG_BINARY(Div, a / b)
+                PCSG_BINARY(Mod, std::fmod(a, b))
+                PCSG_BINARY(Pow, std::pow(a, b))
+                PCSG_BINARY(Lt, a < b ? 1.0 : 0.0)
+                PCSG_BINARY(Le, a <= b ? 1.0 : 0.0)
+                PCSG_BINARY(Gt, a > b ? 1.0 : 0.0)
+                PCSG_BINARY(Ge, a >= b ? 1.0 : 0.0)
+                PCSG_BINARY(Eq, a == b ? 1.0 : 0.0)
+                PCSG_BINARY(Ne, a != b ? 1.0 : 0.0)
 #undef PCSG_BINARY
-            case Op::Jump: pc = in.a; break;
+            case Op::Jump:
+                pc = in.a;
+                break;
             case Op::JumpIfZero:
                 if (stack[--sp] == 0) pc = in.a;
                 break;
@@ -214,7 +250,9 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
                 ++sp;
                 break;
             }
-            case Op::Rand0: stack[sp++] = randAt(seed, s.path, in.a); break;
+            case Op::Rand0:
+                stack[sp++] = randAt(seed, s.path, in.a);
+                break;
             case Op::Choose: {
                 sp -= in.argc;
                 stack[sp] = chooseRule(g, e, stack + sp, in.argc, randAt(seed, s.path, in.a));
@@ -243,7 +281,9 @@ double evalExpr(const Graph& g, ExprId id, EvalState s) {
 // S-nodes, C-nodes, T-nodes, primitives.
 
 namespace {
-const Module& moduleOf(const Graph& g, NodeId n) { return g.modules[g.nodes[n].payload]; }
+const Module& moduleOf(const Graph& g, NodeId n) {
+    return g.modules[g.nodes[n].payload];
+}
 
 [[noreturn]] void nonFinite(const Graph& g, const Expr& e, double v, const char* what,
                             const double* frame) {
@@ -268,7 +308,9 @@ uint32_t selectRule(const Graph& g, NodeId n, EvalState s) {
     }
     const Expr& e = g.exprs[m.select];
     const double v = evalExpr(g, m.select, s);
-    if (!std::isfinite(v)) nonFinite(g, e, v, fmt::format("the selection function of module {}", m.name).c_str(), s.frame);
+    if (!std::isfinite(v))
+        nonFinite(g, e, v, fmt::format("the selection function of module {}", m.name).c_str(),
+                  s.frame);
     const double r = std::round(v);
     if (r < 1 || r > rules)
         throw RuntimeError(e.loc, fmt::format("the selection function of module {} gave rule {}, "
@@ -301,9 +343,12 @@ void applyCalc(const Graph& g, NodeId n, EvalState in, double* out) {
 Affine makeTransform(TransformOp op, const double* a) {
     Affine m;
     switch (op) {
-        case TransformOp::Move: return Affine::translate({a[0], a[1], a[2]});
-        case TransformOp::Scale: return Affine::scale({a[0], a[1], a[2]});
-        case TransformOp::UScale: return Affine::scale({a[0], a[0], a[0]});
+        case TransformOp::Move:
+            return Affine::translate({a[0], a[1], a[2]});
+        case TransformOp::Scale:
+            return Affine::scale({a[0], a[1], a[2]});
+        case TransformOp::UScale:
+            return Affine::scale({a[0], a[0], a[0]});
         case TransformOp::RotX: {
             const double c = cosDeg(a[0]), s = sinDeg(a[0]);
             m.l[1][1] = c, m.l[1][2] = -s, m.l[2][1] = s, m.l[2][2] = c;
@@ -335,10 +380,18 @@ Affine makeTransform(TransformOp op, const double* a) {
             m.l[2][2] = c + t * k.z * k.z;
             return m;
         }
-        case TransformOp::ZShear: m.l[2][0] = a[0], m.l[2][1] = a[1]; return m;
-        case TransformOp::FlipYZ: m.l[0][0] = -1; return m;
-        case TransformOp::FlipXZ: m.l[1][1] = -1; return m;
-        case TransformOp::FlipXY: m.l[2][2] = -1; return m;
+        case TransformOp::ZShear:
+            m.l[2][0] = a[0], m.l[2][1] = a[1];
+            return m;
+        case TransformOp::FlipYZ:
+            m.l[0][0] = -1;
+            return m;
+        case TransformOp::FlipXZ:
+            m.l[1][1] = -1;
+            return m;
+        case TransformOp::FlipXY:
+            m.l[2][2] = -1;
+            return m;
         case TransformOp::Matrix:
             // POV-Ray's row-vector form p' = p·M + t: coordinate i of the result takes
             // p_j times M[j][i], so L[i][j] = M[j][i] = a[3*j + i].
@@ -364,16 +417,19 @@ Affine transformMatrix(const Graph& g, NodeId n, EvalState s) {
     for (uint32_t i = 0; i < t.argCount; ++i) {
         const ExprId id = g.args[t.firstArg + i];
         a[i] = evalExpr(g, id, s);
-        if (!std::isfinite(a[i])) nonFinite(g, g.exprs[id], a[i], "the transformation argument", s.frame);
+        if (!std::isfinite(a[i]))
+            nonFinite(g, g.exprs[id], a[i], "the transformation argument", s.frame);
     }
     const FileLoc loc = t.argCount ? g.exprs[g.args[t.firstArg]].loc : g.nodes[n].loc;
     if (t.op == TransformOp::Rot && a[0] == 0 && a[1] == 0 && a[2] == 0)
-        throw RuntimeError(loc, fmt::format("rot() about the zero axis with {}", describeFrame(g, s.frame)));
+        throw RuntimeError(
+            loc, fmt::format("rot() about the zero axis with {}", describeFrame(g, s.frame)));
     const Affine m = makeTransform(t.op, a);
     if (!(m.determinant() != 0) || !m.isFinite())
-        throw RuntimeError(loc, fmt::format("{} is singular (a zero scale factor?) with {}",
-                                            t.op == TransformOp::Matrix ? "matrix()" : "the transformation",
-                                            describeFrame(g, s.frame)));
+        throw RuntimeError(
+            loc, fmt::format("{} is singular (a zero scale factor?) with {}",
+                             t.op == TransformOp::Matrix ? "matrix()" : "the transformation",
+                             describeFrame(g, s.frame)));
     return m;
 }
 
@@ -386,17 +442,18 @@ void primitiveArgs(const Graph& g, NodeId n, EvalState s, double* out) {
     for (uint32_t i = 0; i < p.argCount; ++i) {
         const ExprId id = g.args[p.firstArg + i];
         out[i] = evalExpr(g, id, s);
-        if (!std::isfinite(out[i])) nonFinite(g, g.exprs[id], out[i], "the primitive argument", s.frame);
+        if (!std::isfinite(out[i]))
+            nonFinite(g, g.exprs[id], out[i], "the primitive argument", s.frame);
     }
 }
 
 void checkDepth(const Graph& g, NodeId n, uint32_t depth, EvalState s) {
     if (depth <= g.scene.settings.maxDepth) return;
     const Module& m = moduleOf(g, n);
-    throw RuntimeError(m.loc, fmt::format("module {} reached depth {}, beyond settings max_depth "
-                                          "{}, with {}: does every path reach a terminating rule?",
-                                          m.name, depth, g.scene.settings.maxDepth,
-                                          describeFrame(g, s.frame)));
+    throw RuntimeError(
+        m.loc, fmt::format("module {} reached depth {}, beyond settings max_depth "
+                           "{}, with {}: does every path reach a terminating rule?",
+                           m.name, depth, g.scene.settings.maxDepth, describeFrame(g, s.frame)));
 }
 
 }  // namespace pcsg

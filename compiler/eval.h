@@ -1,7 +1,7 @@
 // The one semantics of a cyclic CSG graph: evaluating expressions, what an S-node
 // selects, what a C-node assigns, what a T-node's matrix is, and the instance path
 // behind rand(). The tracer and the expander both call these functions and nothing
-// else to give a graph its meaning (LANGUAGE.md sections 3, 4 and 6).
+// else to give a graph its meaning (docs/language.md sections 3, 4 and 6).
 //
 // A parameter frame is a plain array of Graph::slotCount() doubles owned by the
 // caller (a stack buffer or a per-thread arena: no allocation per visit). A slot that
@@ -18,17 +18,17 @@
 
 namespace pcsg {
 
-// A run-time error of LANGUAGE.md: rule number out of range, no notation-B rule applies,
+// A run-time error of docs/language.md: rule number out of range, no notation-B rule applies,
 // a non-finite value in a selection or transformation, a zero scale factor, an
 // unassigned parameter, max_depth exceeded. Thrown by the functions below; the tracer
 // and the expander add the module path as the exception passes their S-node visits,
 // report it once and exit with status 1.
 class RuntimeError : public std::runtime_error {
-public:
+  public:
     RuntimeError(FileLoc loc, std::string message);
 
     FileLoc loc;
-    std::string message;              // without location or module path
+    std::string message;                  // without location or module path
     std::vector<std::string> modulePath;  // outermost first, filled in while unwinding
 
     // Called by a traversal at each S-node the error passes on its way out.
@@ -45,7 +45,7 @@ bool isUnassigned(double v);
 // Fills a new frame: every slot unassigned. `frame` has g.slotCount() doubles.
 void initFrame(const Graph& g, double* frame);
 
-// --- instance paths (LANGUAGE.md section 6) ---------------------------------------------
+// --- instance paths (docs/language.md section 6) ---------------------------------------------
 // The instance path is a 64-bit hash of the choices from the axiom down: which child of
 // each operator and which rule of each S-node. Unary nodes leave it unchanged.
 inline constexpr uint64_t kRootPath = 0x9e3779b97f4a7c15ULL;
@@ -53,8 +53,8 @@ uint64_t pathChild(uint64_t path, uint32_t childIndex);
 uint64_t pathRule(uint64_t path, uint32_t ruleIndex);
 
 // The random numbers of the language: both pure functions, uniform in [0,1).
-double randOf(uint64_t seed, double x);                             // rand(x)
-double randAt(uint64_t seed, uint64_t path, uint32_t callSite);     // rand()
+double randOf(uint64_t seed, double x);                          // rand(x)
+double randAt(uint64_t seed, uint64_t path, uint32_t callSite);  // rand()
 
 // --- evaluation ------------------------------------------------------------------------
 // Everything the functions below need besides the node: the frame, the instance path.
@@ -88,7 +88,7 @@ Affine makeTransform(TransformOp op, const double* args);
 // The precomputed matrix of a T-node whose arguments are the constants `args`, or nothing
 // when they make a singular or non-finite transformation (rot about the zero axis, a zero
 // scale factor): such a T-node stays unfolded, so that the run-time check reports it
-// where it is used (LANGUAGE.md section 5).
+// where it is used (docs/language.md section 5).
 std::optional<Affine> constantTransform(TransformOp op, const double* args);
 
 // A primitive's argument values (torus radii, triangle corners) for the given state.

@@ -36,8 +36,13 @@ TEST(Eval, ArithmeticPrecedenceIsTheCodeOrder) {
     Graph g;
     // (2 + 3) * 4 ^ 2 = 80
     const ExprId e = addCode(g,
-                             {{Op::Const, 0, 0, 2}, {Op::Const, 0, 0, 3}, {Op::Add},
-                              {Op::Const, 0, 0, 4}, {Op::Const, 0, 0, 2}, {Op::Pow}, {Op::Mul}},
+                             {{Op::Const, 0, 0, 2},
+                              {Op::Const, 0, 0, 3},
+                              {Op::Add},
+                              {Op::Const, 0, 0, 4},
+                              {Op::Const, 0, 0, 2},
+                              {Op::Pow},
+                              {Op::Mul}},
                              3);
     EXPECT_DOUBLE_EQ(evalExpr(g, e, {nullptr, kRootPath}), 80.0);
 }
@@ -48,7 +53,8 @@ TEST(Eval, TrigonometryIsInDegreesAndExactAtRightAngles) {
         std::vector<Instr> code;
         for (double a : args) code.push_back({Op::Const, 0, 0, a});
         code.push_back({Op::Call, static_cast<uint8_t>(args.size()), static_cast<uint32_t>(f), 0});
-        return evalExpr(g, addCode(g, code, static_cast<uint32_t>(args.size())), {nullptr, kRootPath});
+        return evalExpr(g, addCode(g, code, static_cast<uint32_t>(args.size())),
+                        {nullptr, kRootPath});
     };
     EXPECT_EQ(call(Func::Sin, {90}), 1.0);
     EXPECT_EQ(call(Func::Cos, {90}), 0.0);
@@ -111,8 +117,10 @@ struct OneModule {
         if (notationB) {
             m.notationB = true;
             // c > 0 , then c == 0
-            m.conditions.push_back(addCode(g, {{Op::Load, 0, c, 0}, {Op::Const, 0, 0, 0}, {Op::Gt}}, 2));
-            m.conditions.push_back(addCode(g, {{Op::Load, 0, c, 0}, {Op::Const, 0, 0, 0}, {Op::Eq}}, 2));
+            m.conditions.push_back(
+                addCode(g, {{Op::Load, 0, c, 0}, {Op::Const, 0, 0, 0}, {Op::Gt}}, 2));
+            m.conditions.push_back(
+                addCode(g, {{Op::Load, 0, c, 0}, {Op::Const, 0, 0, 0}, {Op::Eq}}, 2));
         } else {
             m.select = g.addLoad(c);  // the rule number is c itself
         }
@@ -266,7 +274,8 @@ TEST(Eval, RandomnessIsPureAndUniform) {
 TEST(Eval, ChooseFollowsTheWeights) {
     Graph g;
     // choose(0.6, 0.4), call site 0
-    const ExprId e = addCode(g, {{Op::Const, 0, 0, 0.6}, {Op::Const, 0, 0, 0.4}, {Op::Choose, 2, 0, 0}}, 2);
+    const ExprId e =
+        addCode(g, {{Op::Const, 0, 0, 0.6}, {Op::Const, 0, 0, 0.4}, {Op::Choose, 2, 0, 0}}, 2);
     int first = 0;
     const int n = 20000;
     for (int i = 0; i < n; ++i) {
@@ -293,7 +302,8 @@ TEST(Eval, MaxDepthIsReportedWithTheModuleAndDepth) {
         e.enterModule("S");
         e.enterModule("T");
         m.g.files.push_back("x.pcsg");
-        EXPECT_EQ(e.format(m.g), "x.pcsg:2:1: error: " + e.message + "\n  module path: T -> S (x2)");
+        EXPECT_EQ(e.format(m.g),
+                  "x.pcsg:2:1: error: " + e.message + "\n  module path: T -> S (x2)");
     }
 }
 

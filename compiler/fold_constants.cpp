@@ -47,7 +47,8 @@ void forEachExpr(const Graph& g, NodeId n, F f) {
             for (uint32_t i = 0; i < p.argCount; ++i) f(g.args[p.firstArg + i]);
             break;
         }
-        default: break;
+        default:
+            break;
     }
 }
 

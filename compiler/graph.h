@@ -1,5 +1,5 @@
 // The cyclic CSG graph: the one representation that the compiler produces and that the
-// tracer and the expander read. See ../docs/DESIGN.md and the seed paper, section 2.2.
+// tracer and the expander read. See README.md ("How it works") and the seed paper, section 2.2.
 //
 // Everything is stored in flat arrays indexed by small integers, so that a graph is a
 // handful of vectors (its size in bytes is graphBytes()) and the hot loops of the tracer
@@ -43,16 +43,45 @@ struct FileLoc {
 // Expressions: a flat stack code over parameter slots.
 
 enum class Func : uint8_t {
-    Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Exp, Ln, Log10, Pow, Abs, Floor, Ceil,
-    Min, Max, Mod, Clamp, Rand1,  // rand(x)
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Atan2,
+    Sqrt,
+    Exp,
+    Ln,
+    Log10,
+    Pow,
+    Abs,
+    Floor,
+    Ceil,
+    Min,
+    Max,
+    Mod,
+    Clamp,
+    Rand1,  // rand(x)
 };
 
 enum class Op : uint8_t {
-    Const,       // push imm
-    Load,        // push frame[a]; reading an unassigned slot is a run-time error
-    Neg, Not,    // unary
-    Add, Sub, Mul, Div, Mod, Pow,  // binary: pops b, then a, pushes a op b
-    Lt, Le, Gt, Ge, Eq, Ne,        // comparisons give 1 or 0
+    Const,  // push imm
+    Load,   // push frame[a]; reading an unassigned slot is a run-time error
+    Neg,
+    Not,  // unary
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Mod,
+    Pow,  // binary: pops b, then a, pushes a op b
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,          // comparisons give 1 or 0
     Jump,        // pc = a (absolute index into Graph::code)
     JumpIfZero,  // pops v; if v == 0, pc = a
     ToBool,      // replaces v by (v != 0)
@@ -81,7 +110,14 @@ struct Expr {
 // Nodes.
 
 enum class NodeKind : uint8_t {
-    Select, Transform, Calc, Paint, Union, Intersection, Difference, Primitive,
+    Select,
+    Transform,
+    Calc,
+    Paint,
+    Union,
+    Intersection,
+    Difference,
+    Primitive,
 };
 
 struct Node {
@@ -109,14 +145,18 @@ struct Module {
 };
 
 enum class TransformOp : uint8_t {
-    Move,     // args dx dy dz (alias translate)
-    Scale,    // fx fy fz
-    UScale,   // f
-    RotX, RotY, RotZ,  // a (degrees, right-handed)
-    Rot,      // ax ay az a
-    ZShear,   // a b: (x, y, z + a x + b y)
-    FlipYZ, FlipXZ, FlipXY,  // no args: mirror in that coordinate plane (flipxz: y -> -y)
-    Matrix,   // m11 m12 m13 m21 m22 m23 m31 m32 m33 tx ty tz: p·M + t as in POV-Ray
+    Move,    // args dx dy dz (alias translate)
+    Scale,   // fx fy fz
+    UScale,  // f
+    RotX,
+    RotY,
+    RotZ,    // a (degrees, right-handed)
+    Rot,     // ax ay az a
+    ZShear,  // a b: (x, y, z + a x + b y)
+    FlipYZ,
+    FlipXZ,
+    FlipXY,  // no args: mirror in that coordinate plane (flipxz: y -> -y)
+    Matrix,  // m11 m12 m13 m21 m22 m23 m31 m32 m33 tx ty tz: p·M + t as in POV-Ray
 };
 
 struct Transform {
@@ -140,7 +180,17 @@ struct Calc {
 };
 
 enum class PrimitiveKind : uint8_t {
-    Sphere, Cube, Cylinder, Cone, Tetrahedron, Torus, Plane, Empty, Tri1, Tri2, Triangle,
+    Sphere,
+    Cube,
+    Cylinder,
+    Cone,
+    Tetrahedron,
+    Torus,
+    Plane,
+    Empty,
+    Tri1,
+    Tri2,
+    Triangle,
 };
 
 struct Primitive {
@@ -151,7 +201,7 @@ struct Primitive {
 };
 
 // ---------------------------------------------------------------------------------------
-// Scene directives (LANGUAGE.md section 7). All values are constants.
+// Scene directives (docs/language.md section 7). All values are constants.
 
 struct Camera {
     Vec3 location{0, -5, 2};

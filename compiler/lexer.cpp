@@ -1,11 +1,11 @@
 // The lexer: scanning, #define expansion and the newline rule. See lexer.h.
 #include "lexer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstring>
 #include <unordered_map>
-
-#include <fmt/format.h>
 
 namespace pcsg {
 
@@ -138,10 +138,14 @@ std::string_view spelling(const Source& src, const Token& t) {
 
 std::string describe(const Source& src, const Token& t) {
     switch (t.kind) {
-        case Tok::End: return "end of file";
-        case Tok::Newline: return (t.flags & kForced) ? "the start of a new rule" : "end of line";
-        case Tok::Number: return fmt::format("number '{}'", spelling(src, t));
-        default: break;
+        case Tok::End:
+            return "end of file";
+        case Tok::Newline:
+            return (t.flags & kForced) ? "the start of a new rule" : "end of line";
+        case Tok::Number:
+            return fmt::format("number '{}'", spelling(src, t));
+        default:
+            break;
     }
     std::string_view s = spelling(src, t);
     if (s.size() > 40) return fmt::format("'{}...'", s.substr(0, 40));
@@ -153,16 +157,22 @@ std::string describe(const Source& src, const Token& t) {
 
 namespace {
 
-bool isDigit(unsigned char c) { return c >= '0' && c <= '9'; }
+bool isDigit(unsigned char c) {
+    return c >= '0' && c <= '9';
+}
 bool isIdentStart(unsigned char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
 }
-bool isIdentChar(unsigned char c) { return isIdentStart(c) || isDigit(c); }
+bool isIdentChar(unsigned char c) {
+    return isIdentStart(c) || isDigit(c);
+}
 
-bool full(const Diagnostics& d) { return d.errors().size() >= Diagnostics::kMaxErrors; }
+bool full(const Diagnostics& d) {
+    return d.errors().size() >= Diagnostics::kMaxErrors;
+}
 
 class Scanner {
-public:
+  public:
     Scanner(const Source& src, Diagnostics& diags, std::vector<Token>& out)
         : src_(src), diags_(diags), s_(src.text()), out_(out) {}
 
@@ -199,7 +209,8 @@ public:
                 i = close + 2;
                 continue;
             }
-            if (isDigit(c) || (c == '.' && i + 1 < n && isDigit(static_cast<unsigned char>(s_[i + 1])))) {
+            if (isDigit(c) ||
+                (c == '.' && i + 1 < n && isDigit(static_cast<unsigned char>(s_[i + 1])))) {
                 i = number(i);
             } else if (isIdentStart(c)) {
                 size_t j = i + 1;
@@ -218,7 +229,7 @@ public:
 
     bool stopped() const { return stop_ || full(diags_); }
 
-private:
+  private:
     void error(size_t offset, std::string message) {
         diags_.error(src_.loc(static_cast<uint32_t>(offset)), std::move(message));
     }
@@ -261,10 +272,12 @@ private:
         if (i < n && (isIdentChar(static_cast<unsigned char>(s_[i])) || s_[i] == '.')) bad = true;
         if (bad) {
             size_t j = i;
-            while (j < n && (isIdentChar(static_cast<unsigned char>(s_[j])) || s_[j] == '.' ||
-                             ((s_[j] == '+' || s_[j] == '-') && (s_[j - 1] == 'e' || s_[j - 1] == 'E'))))
+            while (j < n &&
+                   (isIdentChar(static_cast<unsigned char>(s_[j])) || s_[j] == '.' ||
+                    ((s_[j] == '+' || s_[j] == '-') && (s_[j - 1] == 'e' || s_[j - 1] == 'E'))))
                 ++j;
-            error(start, fmt::format("malformed number '{}'", s_.substr(start, std::min<size_t>(j - start, 40))));
+            error(start, fmt::format("malformed number '{}'",
+                                     s_.substr(start, std::min<size_t>(j - start, 40))));
             push(Tok::Number, start, i - start, Kw::None, 0);
             return j;
         }
@@ -277,20 +290,47 @@ private:
         const char c = s_[i];
         const char d = i + 1 < n ? s_[i + 1] : '\0';
         switch (c) {
-            case '(': push(Tok::LParen, i, 1); return i + 1;
-            case ')': push(Tok::RParen, i, 1); return i + 1;
-            case '{': push(Tok::LBrace, i, 1); return i + 1;
-            case '}': push(Tok::RBrace, i, 1); return i + 1;
-            case ',': push(Tok::Comma, i, 1); return i + 1;
-            case ';': push(Tok::Semicolon, i, 1); return i + 1;
-            case ':': push(Tok::Colon, i, 1); return i + 1;
-            case '+': push(Tok::Plus, i, 1); return i + 1;
-            case '*': push(Tok::Star, i, 1); return i + 1;
-            case '/': push(Tok::Slash, i, 1); return i + 1;
-            case '%': push(Tok::Percent, i, 1); return i + 1;
-            case '^': push(Tok::Caret, i, 1); return i + 1;
-            case '\\': push(Tok::Difference, i, 1); return i + 1;
-            case '#': return hash(i);
+            case '(':
+                push(Tok::LParen, i, 1);
+                return i + 1;
+            case ')':
+                push(Tok::RParen, i, 1);
+                return i + 1;
+            case '{':
+                push(Tok::LBrace, i, 1);
+                return i + 1;
+            case '}':
+                push(Tok::RBrace, i, 1);
+                return i + 1;
+            case ',':
+                push(Tok::Comma, i, 1);
+                return i + 1;
+            case ';':
+                push(Tok::Semicolon, i, 1);
+                return i + 1;
+            case ':':
+                push(Tok::Colon, i, 1);
+                return i + 1;
+            case '+':
+                push(Tok::Plus, i, 1);
+                return i + 1;
+            case '*':
+                push(Tok::Star, i, 1);
+                return i + 1;
+            case '/':
+                push(Tok::Slash, i, 1);
+                return i + 1;
+            case '%':
+                push(Tok::Percent, i, 1);
+                return i + 1;
+            case '^':
+                push(Tok::Caret, i, 1);
+                return i + 1;
+            case '\\':
+                push(Tok::Difference, i, 1);
+                return i + 1;
+            case '#':
+                return hash(i);
             case '-':
                 if (d == '>') {
                     push(Tok::Arrow, i, 2);
@@ -340,7 +380,8 @@ private:
                 }
                 push(Tok::Gt, i, 1);
                 return i + 1;
-            default: break;
+            default:
+                break;
         }
         if (c == '\0') {
             error(i, "unexpected NUL byte: this does not look like a text file");
@@ -387,9 +428,12 @@ private:
         const unsigned char c = static_cast<unsigned char>(s_[i]);
         size_t len = 0;
         uint32_t cp = 0;
-        if (c >= 0xC2 && c <= 0xDF) len = 2, cp = c & 0x1F;
-        else if (c >= 0xE0 && c <= 0xEF) len = 3, cp = c & 0x0F;
-        else if (c >= 0xF0 && c <= 0xF4) len = 4, cp = c & 0x07;
+        if (c >= 0xC2 && c <= 0xDF)
+            len = 2, cp = c & 0x1F;
+        else if (c >= 0xE0 && c <= 0xEF)
+            len = 3, cp = c & 0x0F;
+        else if (c >= 0xF0 && c <= 0xF4)
+            len = 4, cp = c & 0x07;
         bool ok = len != 0 && i + len <= n;
         for (size_t k = 1; ok && k < len; ++k) {
             const unsigned char cc = static_cast<unsigned char>(s_[i + k]);
@@ -407,11 +451,20 @@ private:
             return j;
         }
         switch (cp) {
-            case 0x222A: push(Tok::Union, i, len); return i + len;       // ∪
-            case 0x2229: push(Tok::Intersect, i, len); return i + len;   // ∩
-            case 0x2216: push(Tok::Difference, i, len); return i + len;  // ∖ (set minus)
-            case 0x2192: push(Tok::Arrow, i, len); return i + len;       // →
-            default: break;
+            case 0x222A:
+                push(Tok::Union, i, len);
+                return i + len;  // ∪
+            case 0x2229:
+                push(Tok::Intersect, i, len);
+                return i + len;  // ∩
+            case 0x2216:
+                push(Tok::Difference, i, len);
+                return i + len;  // ∖ (set minus)
+            case 0x2192:
+                push(Tok::Arrow, i, len);
+                return i + len;  // →
+            default:
+                break;
         }
         if (cp == 0xA0 || cp == 0x2009 || cp == 0x202F || cp == 0x200B) return i + len;  // spaces
         error(i, fmt::format("unexpected character '{}' (U+{:04X})", s_.substr(i, len), cp));
@@ -430,7 +483,7 @@ private:
 // Step 2: #define
 
 class Expander {
-public:
+  public:
     Expander(const Source& src, Diagnostics& diags, const std::vector<Token>& raw,
              std::vector<Token>& out)
         : src_(src), diags_(diags), raw_(raw), out_(out) {}
@@ -457,17 +510,17 @@ public:
         out_.push_back(raw_.back());
     }
 
-private:
-public:
+  private:
+  public:
     bool stopped() const { return stop_; }
 
-private:
+  private:
     struct Macro {
         std::string_view name;
-        uint32_t hash = 0;                     // raw index of its '#'
-        uint32_t bodyBegin = 0, bodyEnd = 0;   // raw indices
-        bool defined = false;                  // its #define has been passed
-        bool reported = false;                 // its self-expansion was reported
+        uint32_t hash = 0;                    // raw index of its '#'
+        uint32_t bodyBegin = 0, bodyEnd = 0;  // raw indices
+        bool defined = false;                 // its #define has been passed
+        bool reported = false;                // its self-expansion was reported
     };
     struct Frame {
         uint32_t macro;
@@ -479,7 +532,9 @@ private:
         diags_.error(src_.loc(t.offset), std::move(message));
     }
 
-    bool sameLine(size_t i) const { return i < raw_.size() && raw_[i].kind != Tok::End && !(raw_[i].flags & kLineStart); }
+    bool sameLine(size_t i) const {
+        return i < raw_.size() && raw_[i].kind != Tok::End && !(raw_[i].flags & kLineStart);
+    }
 
     // The first #define of every name, so that a use before it can be recognised.
     void collect() {
@@ -518,9 +573,12 @@ private:
     size_t matchBrace(size_t i) const {
         size_t depth = 0;
         for (size_t k = i; k < raw_.size() - 1; ++k) {
-            if (raw_[k].kind == Tok::LBrace) ++depth;
-            else if (raw_[k].kind == Tok::RBrace && --depth == 0) return k + 1;
-            else if (raw_[k].kind == Tok::Hash && (raw_[k].flags & kLineStart)) return 0;
+            if (raw_[k].kind == Tok::LBrace)
+                ++depth;
+            else if (raw_[k].kind == Tok::RBrace && --depth == 0)
+                return k + 1;
+            else if (raw_[k].kind == Tok::Hash && (raw_[k].flags & kLineStart))
+                return 0;
         }
         return 0;
     }
@@ -540,8 +598,10 @@ private:
                 error(hash, "expected 'define' after '#'");
             return skipLine(i + 1);
         }
-        if (!sameLine(i + 2) || (raw_[i + 2].kind != Tok::Ident && raw_[i + 2].kind != Tok::Keyword)) {
-            error(sameLine(i + 2) ? raw_[i + 2] : raw_[i + 1], "expected a macro name after #define");
+        if (!sameLine(i + 2) ||
+            (raw_[i + 2].kind != Tok::Ident && raw_[i + 2].kind != Tok::Keyword)) {
+            error(sameLine(i + 2) ? raw_[i + 2] : raw_[i + 1],
+                  "expected a macro name after #define");
             return skipLine(i + 2);
         }
         const Token& nameTok = raw_[i + 2];
@@ -557,7 +617,8 @@ private:
             if (raw_[begin].kind == Tok::LBrace) {
                 const size_t close = matchBrace(begin);
                 if (close == 0) {
-                    error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", clip(name)));
+                    error(raw_[begin],
+                          fmt::format("the '{{' of #define {} is never closed", clip(name)));
                     stop_ = true;
                     return raw_.size() - 1;
                 }
@@ -576,7 +637,8 @@ private:
             // The paper's figure 8: the name alone, the block on the following lines.
             const size_t close = matchBrace(begin);
             if (close == 0) {
-                error(raw_[begin], fmt::format("the '{{' of #define {} is never closed", clip(name)));
+                error(raw_[begin],
+                      fmt::format("the '{{' of #define {} is never closed", clip(name)));
                 stop_ = true;
                 return raw_.size() - 1;
             }
@@ -663,8 +725,7 @@ private:
             return false;
         }
         if (active_[index]) {
-            if (!m.reported)
-                error(at, fmt::format("macro '{}' expands into itself", clip(m.name)));
+            if (!m.reported) error(at, fmt::format("macro '{}' expands into itself", clip(m.name)));
             m.reported = true;
             return false;
         }
@@ -693,9 +754,9 @@ private:
 // Step 3: the newline rule
 
 bool isDirectiveKeyword(const Token& t) {
-    return t.kind == Tok::Keyword && (t.kw == Kw::Camera || t.kw == Kw::Light ||
-                                      t.kw == Kw::Background || t.kw == Kw::Material ||
-                                      t.kw == Kw::Settings);
+    return t.kind == Tok::Keyword &&
+           (t.kw == Kw::Camera || t.kw == Kw::Light || t.kw == Kw::Background ||
+            t.kw == Kw::Material || t.kw == Kw::Settings);
 }
 
 // Whether a statement (or an item inside braces) may end after this token.
@@ -704,11 +765,14 @@ bool canEnd(const Token& t, bool directive) {
         case Tok::Number:
         case Tok::Ident:
         case Tok::Keyword:
-        case Tok::RParen: return true;
+        case Tok::RParen:
+            return true;
         // A directive's '}' and a vector's '>' end an item; a C-node's '}' needs its operand.
         case Tok::RBrace:
-        case Tok::Gt: return directive;
-        default: return false;
+        case Tok::Gt:
+            return directive;
+        default:
+            return false;
     }
 }
 
@@ -728,8 +792,9 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
     for (size_t i = 0; i < in.size(); ++i) {
         Token t = in[i];
         if ((t.flags & kLineStart) && any && t.kind != Tok::End) {
-            const bool ruleStart = (t.kind == Tok::Ident || (t.kind == Tok::Number && (t.flags & kInteger))) &&
-                                   i + 1 < in.size() && in[i + 1].kind == Tok::Colon;
+            const bool ruleStart =
+                (t.kind == Tok::Ident || (t.kind == Tok::Number && (t.flags & kInteger))) &&
+                i + 1 < in.size() && in[i + 1].kind == Tok::Colon;
             if (!brackets.empty() && ruleStart) {
                 // Unbalanced brackets before a line that starts a rule: end the statement
                 // there, so that one missing ')' costs one error, not the rest of the file.
@@ -754,8 +819,12 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
             statementStart = false;
         }
         switch (t.kind) {
-            case Tok::LParen: brackets.push_back('('); break;
-            case Tok::LBrace: brackets.push_back('{'); break;
+            case Tok::LParen:
+                brackets.push_back('(');
+                break;
+            case Tok::LBrace:
+                brackets.push_back('{');
+                break;
             case Tok::RParen:
             case Tok::RBrace:
                 if (!brackets.empty()) brackets.pop_back();
@@ -766,7 +835,8 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
                     statementStart = true;
                 }
                 break;
-            default: break;
+            default:
+                break;
         }
         out.push_back(t);
         prev = t;
@@ -791,7 +861,8 @@ TokenStream lex(const Source& src, Diagnostics& diags) {
 
     TokenStream ts;
     ts.complete = !scanner.stopped();
-    const bool macros = std::any_of(raw.begin(), raw.end(), [](const Token& t) { return t.kind == Tok::Hash; });
+    const bool macros =
+        std::any_of(raw.begin(), raw.end(), [](const Token& t) { return t.kind == Tok::Hash; });
     std::vector<Token> expanded;
     if (macros) {
         Expander expander(src, diags, raw, expanded);

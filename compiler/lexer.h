@@ -1,4 +1,4 @@
-// The lexer: .pcsg text -> tokens (LANGUAGE.md sections 1 and 2).
+// The lexer: .pcsg text -> tokens (docs/language.md sections 1 and 2).
 //
 // Three steps, each linear in the input:
 //  1. scan: bytes -> raw tokens (comments and blanks dropped, each token knowing whether
@@ -23,7 +23,7 @@ namespace pcsg {
 
 // One source text and its line table: byte offsets -> FileLoc.
 class Source {
-public:
+  public:
     Source(std::string_view text, uint32_t file);
     std::string_view text() const { return text_; }
     uint32_t file() const { return file_; }
@@ -31,7 +31,7 @@ public:
     // lies on the last line.
     FileLoc loc(uint32_t offset) const;
 
-private:
+  private:
     std::string_view text_;
     uint32_t file_;
     std::vector<uint32_t> lineStarts_;
@@ -43,15 +43,30 @@ enum class Tok : uint8_t {
     Semicolon,  // ;
     Comma,      // ,
     Colon,      // :
-    LParen, RParen, LBrace, RBrace,
+    LParen,
+    RParen,
+    LBrace,
+    RBrace,
     Arrow,       // -> or →
     Union,       // | or ∪
     Intersect,   // & or ∩
     Difference,  // '\'
     Assign,      // =
-    Eq, Ne, Lt, Le, Gt, Ge,
-    Plus, Minus, Star, Slash, Percent, Caret, Bang,
-    AndAnd, OrOr,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Plus,
+    Minus,
+    Star,
+    Slash,
+    Percent,
+    Caret,
+    Bang,
+    AndAnd,
+    OrOr,
     Number,
     Ident,
     Keyword,
@@ -61,16 +76,62 @@ enum class Tok : uint8_t {
 enum class Kw : uint8_t {
     None,
     // scene directives
-    Camera, Light, Background, Material, Settings,
+    Camera,
+    Light,
+    Background,
+    Material,
+    Settings,
     // CSG
     Paint,
-    Move, Translate, Scale, UScale, RotX, RotY, RotZ, Rot, ZShear, FlipYZ, FlipXZ, FlipXY,
+    Move,
+    Translate,
+    Scale,
+    UScale,
+    RotX,
+    RotY,
+    RotZ,
+    Rot,
+    ZShear,
+    FlipYZ,
+    FlipXZ,
+    FlipXY,
     Matrix,
-    Sphere, Cube, Cylinder, Cone, Tetrahedron, Torus, Plane, Empty, Tri1, Tri2, Triangle,
+    Sphere,
+    Cube,
+    Cylinder,
+    Cone,
+    Tetrahedron,
+    Torus,
+    Plane,
+    Empty,
+    Tri1,
+    Tri2,
+    Triangle,
     // expressions
-    If, Rand, Choose, Pi, E,
-    Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Exp, Ln, Log10, Pow, Abs, Floor, Ceil,
-    Min, Max, Mod, Clamp,
+    If,
+    Rand,
+    Choose,
+    Pi,
+    E,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Atan2,
+    Sqrt,
+    Exp,
+    Ln,
+    Log10,
+    Pow,
+    Abs,
+    Floor,
+    Ceil,
+    Min,
+    Max,
+    Mod,
+    Clamp,
 };
 
 // Token flags.
@@ -113,7 +174,7 @@ std::string clip(std::string_view name);
 Kw keywordOf(std::string_view word);
 std::string_view keywordName(Kw k);
 
-// Size limits (LANGUAGE.md section 8: never crash or hang, whatever the input).
+// Size limits (docs/language.md section 8: never crash or hang, whatever the input).
 inline constexpr size_t kMaxSourceBytes = size_t(256) << 20;  // 256 MB
 // Macro expansion may add at most this many tokens to a file's own.
 inline constexpr size_t kMaxExpansionTokens = size_t(1) << 20;

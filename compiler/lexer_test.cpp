@@ -1,4 +1,4 @@
-// Tests of the lexer: tokens, #define and the newline rule (LANGUAGE.md sections 1, 2).
+// Tests of the lexer: tokens, #define and the newline rule (docs/language.md sections 1, 2).
 #include "lexer.h"
 
 #include <gtest/gtest.h>
@@ -32,9 +32,12 @@ std::string render(const std::string& text) {
     std::string out;
     for (const Token& t : l->ts.tokens) {
         if (!out.empty()) out += ' ';
-        if (t.kind == Tok::Newline) out += (t.flags & kTopLevel) ? "NL" : "nl";
-        else if (t.kind == Tok::End) out += "EOF";
-        else out += std::string(spelling(*l->src, t));
+        if (t.kind == Tok::Newline)
+            out += (t.flags & kTopLevel) ? "NL" : "nl";
+        else if (t.kind == Tok::End)
+            out += "EOF";
+        else
+            out += std::string(spelling(*l->src, t));
     }
     return out;
 }
@@ -50,20 +53,22 @@ std::string errors(const std::string& text) {
     auto l = lexText(text);
     std::string out;
     for (const auto& d : l->diags.errors())
-        out += std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + ": " + d.message + "\n";
+        out += std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + ": " + d.message +
+               "\n";
     return out;
 }
 
 TEST(Lexer, UnicodeAndAsciiOperatorsAreTheSameTokens) {
     EXPECT_EQ(kinds("A ∪ B ∩ C \\ D → E"), kinds("A | B & C \\ D -> E"));
     EXPECT_EQ(kinds("A | B"), (std::vector<Tok>{Tok::Ident, Tok::Union, Tok::Ident, Tok::End}));
-    EXPECT_EQ(kinds("a || b && c"),
-              (std::vector<Tok>{Tok::Ident, Tok::OrOr, Tok::Ident, Tok::AndAnd, Tok::Ident, Tok::End}));
-    EXPECT_EQ(kinds("a == b != c = d"), (std::vector<Tok>{Tok::Ident, Tok::Eq, Tok::Ident, Tok::Ne,
-                                                          Tok::Ident, Tok::Assign, Tok::Ident, Tok::End}));
+    EXPECT_EQ(kinds("a || b && c"), (std::vector<Tok>{Tok::Ident, Tok::OrOr, Tok::Ident,
+                                                      Tok::AndAnd, Tok::Ident, Tok::End}));
+    EXPECT_EQ(kinds("a == b != c = d"),
+              (std::vector<Tok>{Tok::Ident, Tok::Eq, Tok::Ident, Tok::Ne, Tok::Ident, Tok::Assign,
+                                Tok::Ident, Tok::End}));
     EXPECT_EQ(kinds("a <= b >= c < d > e"),
-              (std::vector<Tok>{Tok::Ident, Tok::Le, Tok::Ident, Tok::Ge, Tok::Ident, Tok::Lt, Tok::Ident,
-                                Tok::Gt, Tok::Keyword, Tok::End}));
+              (std::vector<Tok>{Tok::Ident, Tok::Le, Tok::Ident, Tok::Ge, Tok::Ident, Tok::Lt,
+                                Tok::Ident, Tok::Gt, Tok::Keyword, Tok::End}));
     EXPECT_EQ(kinds("c-1 -> x"), (std::vector<Tok>{Tok::Ident, Tok::Minus, Tok::Number, Tok::Arrow,
                                                    Tok::Ident, Tok::End}));
     EXPECT_EQ(errors("A ∪ B ∩ C \\ D → E ∖ F"), "");
@@ -82,7 +87,8 @@ TEST(Lexer, NumbersInEveryForm) {
 }
 
 TEST(Lexer, MalformedNumbersAreErrors) {
-    EXPECT_NE(errors("x = 1e+").find("1:5: malformed number '1e+'"), std::string::npos) << errors("x = 1e+");
+    EXPECT_NE(errors("x = 1e+").find("1:5: malformed number '1e+'"), std::string::npos)
+        << errors("x = 1e+");
     EXPECT_NE(errors("2x").find("malformed number '2x'"), std::string::npos);
     EXPECT_NE(errors("1.2.3").find("malformed number '1.2.3'"), std::string::npos);
 }
@@ -128,14 +134,18 @@ TEST(Lexer, BadBytesGetOneCleanErrorEach) {
     EXPECT_EQ(errors("a \xE2\x88 b"), "1:3: invalid UTF-8 byte 0xE2\n");
     EXPECT_EQ(errors("a ü b"), "1:3: unexpected character 'ü' (U+00FC)\n");
     // A NUL byte stops the lexer: binary files get one error, not fifty.
-    EXPECT_EQ(errors(std::string("a \0 $ $ $", 9)), "1:3: unexpected NUL byte: this does not look like a text file\n");
-    EXPECT_EQ(errors("\xEF\xBB\xBF" "a"), "");  // a byte-order mark is skipped
+    EXPECT_EQ(errors(std::string("a \0 $ $ $", 9)),
+              "1:3: unexpected NUL byte: this does not look like a text file\n");
+    EXPECT_EQ(errors("\xEF\xBB\xBF"
+                     "a"),
+              "");  // a byte-order mark is skipped
 }
 
 // --- the newline rule (section 2) ---
 
 TEST(NewlineRule, ALineBreakEndsAStatement) {
-    EXPECT_EQ(render("S if(c>0,2,1)\n1: S -> cube\n"), "S if ( c > 0 , 2 , 1 ) NL 1 : S -> cube EOF");
+    EXPECT_EQ(render("S if(c>0,2,1)\n1: S -> cube\n"),
+              "S if ( c > 0 , 2 , 1 ) NL 1 : S -> cube EOF");
     EXPECT_EQ(render("a; b"), "a ; b EOF");
 }
 
@@ -152,7 +162,8 @@ TEST(NewlineRule, ATokenThatCannotEndAnExpressionContinuesTheLine) {
 }
 
 TEST(NewlineRule, LineBreaksInsideParenthesesAreIgnored) {
-    EXPECT_EQ(render("1: S -> move(1,\n 2,\n 3) (A\n ∪ B\n)"), "1 : S -> move ( 1 , 2 , 3 ) ( A ∪ B ) EOF");
+    EXPECT_EQ(render("1: S -> move(1,\n 2,\n 3) (A\n ∪ B\n)"),
+              "1 : S -> move ( 1 , 2 , 3 ) ( A ∪ B ) EOF");
 }
 
 TEST(NewlineRule, InsideBracesALineBreakSeparatesItems) {
@@ -163,8 +174,9 @@ TEST(NewlineRule, InsideBracesALineBreakSeparatesItems) {
 }
 
 TEST(NewlineRule, DirectivesEndAfterTheirBraceOrVector) {
-    EXPECT_EQ(render("background <1,2,3>\ncamera { angle 40\n location <1,\n2,3>\n}\nS"),
-              "background < 1 , 2 , 3 > NL camera { angle 40 nl location < 1 , 2 , 3 > nl } NL S EOF");
+    EXPECT_EQ(
+        render("background <1,2,3>\ncamera { angle 40\n location <1,\n2,3>\n}\nS"),
+        "background < 1 , 2 , 3 > NL camera { angle 40 nl location < 1 , 2 , 3 > nl } NL S EOF");
 }
 
 TEST(NewlineRule, AnUnclosedBracketEndsAtTheNextRule) {
@@ -195,11 +207,13 @@ TEST(Define, MacrosMayUseEarlierMacrosAndExpandWhereUsed) {
 }
 
 TEST(Define, UseBeforeDefineIsAnError) {
-    EXPECT_EQ(errors("S X\n#define X 1\n"), "1:3: macro 'X' is used before its #define at line 2\n");
+    EXPECT_EQ(errors("S X\n#define X 1\n"),
+              "1:3: macro 'X' is used before its #define at line 2\n");
 }
 
 TEST(Define, RedefinitionIsAnError) {
-    EXPECT_EQ(errors("#define X 1\n#define X 2\n"), "2:9: macro 'X' is already defined at line 1\n");
+    EXPECT_EQ(errors("#define X 1\n#define X 2\n"),
+              "2:9: macro 'X' is already defined at line 1\n");
 }
 
 TEST(Define, SelfExpansionIsAnError) {
@@ -209,18 +223,22 @@ TEST(Define, SelfExpansionIsAnError) {
 }
 
 TEST(Define, BadDirectivesAreErrors) {
-    EXPECT_EQ(errors("#include x\n"), "1:2: unknown directive '#include': only #define is supported\n");
-    EXPECT_EQ(errors("#define sphere 1\n"), "1:9: 'sphere' is a keyword and cannot be a macro name\n");
+    EXPECT_EQ(errors("#include x\n"),
+              "1:2: unknown directive '#include': only #define is supported\n");
+    EXPECT_EQ(errors("#define sphere 1\n"),
+              "1:9: 'sphere' is a keyword and cannot be a macro name\n");
     EXPECT_EQ(errors("#define\n"), "1:2: expected a macro name after #define\n");
     EXPECT_EQ(errors("a # define X\n"), "1:3: '#' must be the first thing on its line\n");
     EXPECT_EQ(errors("#define X\n{ a = 1\n"), "2:1: the '{' of #define X is never closed\n");
-    EXPECT_EQ(errors("#define X {\n a = 1\n} b\n"), "3:3: unexpected 'b' after the block of #define X\n");
+    EXPECT_EQ(errors("#define X {\n a = 1\n} b\n"),
+              "3:3: unexpected 'b' after the block of #define X\n");
 }
 
 TEST(Define, ExponentialExpansionStopsWithAnError) {
     std::string text;
     for (int i = 0; i < 40; ++i)
-        text += "#define M" + std::to_string(i) + " M" + std::to_string(i + 1) + " M" + std::to_string(i + 1) + "\n";
+        text += "#define M" + std::to_string(i) + " M" + std::to_string(i + 1) + " M" +
+                std::to_string(i + 1) + "\n";
     text += "#define M40 x\nS M0\n";
     const std::string e = errors(text);
     EXPECT_NE(e.find("macro expansion makes more than"), std::string::npos) << e;
@@ -229,7 +247,8 @@ TEST(Define, ExponentialExpansionStopsWithAnError) {
 TEST(Define, AChainOfManyMacrosDoesNotRecurse) {
     std::string text;
     const int n = 100000;
-    for (int i = 0; i < n; ++i) text += "#define M" + std::to_string(i) + " M" + std::to_string(i + 1) + "\n";
+    for (int i = 0; i < n; ++i)
+        text += "#define M" + std::to_string(i) + " M" + std::to_string(i + 1) + "\n";
     text += "#define M" + std::to_string(n) + " 42\nS M0\n";
     EXPECT_EQ(render(text), "S 42 EOF");
 }

@@ -2,11 +2,11 @@
 // is headed by the grammar rule it parses (EBNF: {x} repeats, [x] is optional).
 #include "parser.h"
 
+#include <fmt/format.h>
+
 #include <charconv>
 #include <cmath>
 #include <numbers>
-
-#include <fmt/format.h>
 
 namespace pcsg {
 
@@ -14,63 +14,115 @@ namespace {
 
 struct Abort {};  // thrown on a syntax error: unwinds to the statement level
 
-bool isCsgOperator(Tok k) { return k == Tok::Union || k == Tok::Intersect || k == Tok::Difference; }
-bool isSeparator(Tok k) { return k == Tok::Newline || k == Tok::Semicolon || k == Tok::Comma; }
+bool isCsgOperator(Tok k) {
+    return k == Tok::Union || k == Tok::Intersect || k == Tok::Difference;
+}
+bool isSeparator(Tok k) {
+    return k == Tok::Newline || k == Tok::Semicolon || k == Tok::Comma;
+}
 
 bool isTransform(Kw k) {
     switch (k) {
-        case Kw::Move: case Kw::Translate: case Kw::Scale: case Kw::UScale: case Kw::RotX:
-        case Kw::RotY: case Kw::RotZ: case Kw::Rot: case Kw::ZShear: case Kw::FlipYZ:
-        case Kw::FlipXZ: case Kw::FlipXY: case Kw::Matrix: return true;
-        default: return false;
+        case Kw::Move:
+        case Kw::Translate:
+        case Kw::Scale:
+        case Kw::UScale:
+        case Kw::RotX:
+        case Kw::RotY:
+        case Kw::RotZ:
+        case Kw::Rot:
+        case Kw::ZShear:
+        case Kw::FlipYZ:
+        case Kw::FlipXZ:
+        case Kw::FlipXY:
+        case Kw::Matrix:
+            return true;
+        default:
+            return false;
     }
 }
 TransformOp transformOp(Kw k) {
     switch (k) {
-        case Kw::Move: case Kw::Translate: return TransformOp::Move;
-        case Kw::Scale: return TransformOp::Scale;
-        case Kw::UScale: return TransformOp::UScale;
-        case Kw::RotX: return TransformOp::RotX;
-        case Kw::RotY: return TransformOp::RotY;
-        case Kw::RotZ: return TransformOp::RotZ;
-        case Kw::Rot: return TransformOp::Rot;
-        case Kw::ZShear: return TransformOp::ZShear;
-        case Kw::FlipYZ: return TransformOp::FlipYZ;
-        case Kw::FlipXZ: return TransformOp::FlipXZ;
-        case Kw::FlipXY: return TransformOp::FlipXY;
-        default: return TransformOp::Matrix;
+        case Kw::Move:
+        case Kw::Translate:
+            return TransformOp::Move;
+        case Kw::Scale:
+            return TransformOp::Scale;
+        case Kw::UScale:
+            return TransformOp::UScale;
+        case Kw::RotX:
+            return TransformOp::RotX;
+        case Kw::RotY:
+            return TransformOp::RotY;
+        case Kw::RotZ:
+            return TransformOp::RotZ;
+        case Kw::Rot:
+            return TransformOp::Rot;
+        case Kw::ZShear:
+            return TransformOp::ZShear;
+        case Kw::FlipYZ:
+            return TransformOp::FlipYZ;
+        case Kw::FlipXZ:
+            return TransformOp::FlipXZ;
+        case Kw::FlipXY:
+            return TransformOp::FlipXY;
+        default:
+            return TransformOp::Matrix;
     }
 }
-bool isFlip(Kw k) { return k == Kw::FlipYZ || k == Kw::FlipXZ || k == Kw::FlipXY; }
+bool isFlip(Kw k) {
+    return k == Kw::FlipYZ || k == Kw::FlipXZ || k == Kw::FlipXY;
+}
 
-bool isPrimitive(Kw k) { return k >= Kw::Sphere && k <= Kw::Triangle; }
+bool isPrimitive(Kw k) {
+    return k >= Kw::Sphere && k <= Kw::Triangle;
+}
 PrimitiveKind primitiveKind(Kw k) {
     return static_cast<PrimitiveKind>(static_cast<int>(k) - static_cast<int>(Kw::Sphere));
 }
 static_assert(static_cast<int>(Kw::Triangle) - static_cast<int>(Kw::Sphere) ==
               static_cast<int>(PrimitiveKind::Triangle));
 
-bool isFunction(Kw k) { return k == Kw::If || k == Kw::Rand || k == Kw::Choose || (k >= Kw::Sin && k <= Kw::Clamp); }
-bool isDirective(Kw k) { return k >= Kw::Camera && k <= Kw::Settings; }
+bool isFunction(Kw k) {
+    return k == Kw::If || k == Kw::Rand || k == Kw::Choose || (k >= Kw::Sin && k <= Kw::Clamp);
+}
+bool isDirective(Kw k) {
+    return k >= Kw::Camera && k <= Kw::Settings;
+}
 
 // Binary operator precedence, loosest 1 to tightest 6; 0: not a binary operator.
 // ('^' and the unary operators are handled by their own functions.)
 int precedence(Tok k, bool assignIsEq) {
     switch (k) {
-        case Tok::OrOr: return 1;
-        case Tok::AndAnd: return 2;
-        case Tok::Eq: case Tok::Ne: return 3;
-        case Tok::Assign: return assignIsEq ? 3 : 0;
-        case Tok::Lt: case Tok::Le: case Tok::Gt: case Tok::Ge: return 4;
-        case Tok::Plus: case Tok::Minus: return 5;
-        case Tok::Star: case Tok::Slash: case Tok::Percent: return 6;
-        default: return 0;
+        case Tok::OrOr:
+            return 1;
+        case Tok::AndAnd:
+            return 2;
+        case Tok::Eq:
+        case Tok::Ne:
+            return 3;
+        case Tok::Assign:
+            return assignIsEq ? 3 : 0;
+        case Tok::Lt:
+        case Tok::Le:
+        case Tok::Gt:
+        case Tok::Ge:
+            return 4;
+        case Tok::Plus:
+        case Tok::Minus:
+            return 5;
+        case Tok::Star:
+        case Tok::Slash:
+        case Tok::Percent:
+            return 6;
+        default:
+            return 0;
     }
 }
 constexpr int kAdditive = 5;
 
 class Parser {
-public:
+  public:
     Parser(const Source& src, const TokenStream& ts, Diagnostics& diags)
         : src_(src), t_(ts.tokens), diags_(diags) {}
 
@@ -98,19 +150,21 @@ public:
                 assignIsEq_ = false;
                 statement();
                 if (!at(Tok::Newline) && !at(Tok::Semicolon) && !at(Tok::End))
-                    fail(p_, fmt::format("expected the end of the statement, found {}", describe(src_, tok())));
+                    fail(p_, fmt::format("expected the end of the statement, found {}",
+                                         describe(src_, tok())));
             } catch (const Abort&) {
                 // Panic mode: drop the statement, resume after its end.
                 ast_.stmts.resize(statements);
                 dropped(start);
-                while (!at(Tok::End) && !((at(Tok::Newline) || at(Tok::Semicolon)) && (tok().flags & kTopLevel)))
+                while (!at(Tok::End) &&
+                       !((at(Tok::Newline) || at(Tok::Semicolon)) && (tok().flags & kTopLevel)))
                     ++p_;
             }
         }
         return std::move(ast_);
     }
 
-private:
+  private:
     // Records what a statement that failed to parse may have declared.
     void dropped(size_t start) {
         ++ast_.dropped;
@@ -185,7 +239,8 @@ private:
             const Token& t = t_[i];
             if (t.kind == Tok::Arrow) return true;
             if (t.kind == Tok::End) return false;
-            if ((t.kind == Tok::Newline || t.kind == Tok::Semicolon) && (t.flags & kTopLevel)) return false;
+            if ((t.kind == Tok::Newline || t.kind == Tok::Semicolon) && (t.flags & kTopLevel))
+                return false;
         }
         return false;
     }
@@ -216,15 +271,18 @@ private:
         double value = 0;
         std::from_chars(digits.data(), digits.data() + digits.size(), value);
         if (!(n.flags & kInteger) || value < 1)
-            fail(p_, fmt::format("a rule number must be a whole number from 1 up, found '{}'", clip(digits)));
+            fail(p_, fmt::format("a rule number must be a whole number from 1 up, found '{}'",
+                                 clip(digits)));
         if (value > kMaxRuleNumber)
-            fail(p_, fmt::format("rule number {} is too large (at most {})", clip(digits), kMaxRuleNumber));
+            fail(p_, fmt::format("rule number {} is too large (at most {})", clip(digits),
+                                 kMaxRuleNumber));
         s.number = static_cast<uint32_t>(value);
         p_ += 2;
         s.nameTok = name("a module");
         if (at(Tok::LParen))
-            fail(p_, "a numbered rule (notation A) has no parameter list; notation-B rules are "
-                     "labelled by a name, as in 'p1: S(c) -> ...'");
+            fail(p_,
+                 "a numbered rule (notation A) has no parameter list; notation-B rules are "
+                 "labelled by a name, as in 'p1: S(c) -> ...'");
         arrow();
         s.body = csg();
         ast_.stmts.push_back(s);
@@ -291,14 +349,16 @@ private:
         s.tok = s.nameTok = pos();
         ++p_;
         if (at(Tok::Arrow))
-            fail(p_, "a rule needs a number (notation A: '1: S -> ...') or a label (notation B: "
-                     "'p1: S -> ...')");
+            fail(p_,
+                 "a rule needs a number (notation A: '1: S -> ...') or a label (notation B: "
+                 "'p1: S -> ...')");
         s.expr = expr();
         if (isCsgOperator(tok().kind))
-            fail(p_, fmt::format("expected the end of the statement, found {}: this line declares "
-                                 "module {} (a name followed by its selection function); an axiom "
-                                 "that calls a notation-B module needs a label, as in 'w: {}(...)'",
-                                 describe(src_, tok()), clip(text(s.nameTok)), clip(text(s.nameTok))));
+            fail(p_,
+                 fmt::format("expected the end of the statement, found {}: this line declares "
+                             "module {} (a name followed by its selection function); an axiom "
+                             "that calls a notation-B module needs a label, as in 'w: {}(...)'",
+                             describe(src_, tok()), clip(text(s.nameTok)), clip(text(s.nameTok))));
         ast_.stmts.push_back(s);
     }
 
@@ -323,7 +383,9 @@ private:
         if (s.directive == Kw::Background) {
             DirectiveItem item;
             item.nameTok = s.tok;
-            if (!at(Tok::Lt)) fail(p_, fmt::format("expected a colour '<r, g, b>' after 'background', found {}", describe(src_, tok())));
+            if (!at(Tok::Lt))
+                fail(p_, fmt::format("expected a colour '<r, g, b>' after 'background', found {}",
+                                     describe(src_, tok())));
             vector(item);
             items.push_back(item);
         } else {
@@ -343,7 +405,8 @@ private:
             while (isSeparator(tok().kind) && !(tok().flags & kForced)) ++p_;
             if (at(Tok::RBrace)) break;
             if (!at(Tok::Ident))
-                fail(p_, fmt::format("expected a setting name or '}}', found {}", describe(src_, tok())));
+                fail(p_, fmt::format("expected a setting name or '}}', found {}",
+                                     describe(src_, tok())));
             DirectiveItem item;
             item.nameTok = pos();
             ++p_;
@@ -436,7 +499,8 @@ private:
             ++p_;
             if (!isFlip(t.kw)) {
                 if (!at(Tok::LParen))
-                    fail(p_, fmt::format("expected '(' after '{}', found {}", text(n.tok), describe(src_, tok())));
+                    fail(p_, fmt::format("expected '(' after '{}', found {}", text(n.tok),
+                                         describe(src_, tok())));
                 args(n.first, n.count);
             }
             n.child = unary();
@@ -494,12 +558,16 @@ private:
             return inner;
         }
         if (t.kind == Tok::Keyword && !isFunction(t.kw) && t.kw != Kw::Paint)
-            fail(p_, fmt::format("'{}' is a keyword and cannot name a module or definition", text(pos())));
+            fail(p_, fmt::format("'{}' is a keyword and cannot name a module or definition",
+                                 text(pos())));
         std::string hint;
         if (t.kind == Tok::Newline || t.kind == Tok::End || t.kind == Tok::Semicolon)
-            hint = " (an operator at the end of a line continues the statement; a prefix needs its operand)";
-        fail(p_, fmt::format("expected a primitive, a module or definition name, or '(', found {}{}",
-                             describe(src_, t), hint));
+            hint =
+                " (an operator at the end of a line continues the statement; a prefix needs its "
+                "operand)";
+        fail(p_,
+             fmt::format("expected a primitive, a module or definition name, or '(', found {}{}",
+                         describe(src_, t), hint));
     }
 
     // cnode -> '{' { separator } [ assignment { separator { separator } assignment } ]
@@ -517,11 +585,12 @@ private:
                 continue;
             }
             if (at(Tok::RBrace)) break;
-            if (at(Tok::End) || (tok().flags & kForced))
-                fail(open, "this '{' is never closed");
+            if (at(Tok::End) || (tok().flags & kForced)) fail(open, "this '{' is never closed");
             if (needSeparator)
-                fail(p_, fmt::format("expected ';', ',', a line break or '}}' after the assignment, found {}",
-                                     describe(src_, tok())));
+                fail(p_,
+                     fmt::format(
+                         "expected ';', ',', a line break or '}}' after the assignment, found {}",
+                         describe(src_, tok())));
             Assign a;
             a.nameTok = name("a parameter");
             if (at(Tok::Eq)) fail(p_, "expected '=' in the assignment ('==' compares)");
@@ -549,7 +618,8 @@ private:
             }
         }
         if (!at(Tok::RParen))
-            fail(p_, fmt::format("expected ',' or ')' in the argument list, found {}", describe(src_, tok())));
+            fail(p_, fmt::format("expected ',' or ')' in the argument list, found {}",
+                                 describe(src_, tok())));
         ++p_;
         first = static_cast<uint32_t>(ast_.lists.size());
         count = static_cast<uint32_t>(list.size());
@@ -649,11 +719,13 @@ private:
             ++p_;
             return addExpr(n);
         }
-        if ((t.kind == Tok::Keyword && isFunction(t.kw)) || (t.kind == Tok::Ident && tok(1).kind == Tok::LParen)) {
+        if ((t.kind == Tok::Keyword && isFunction(t.kw)) ||
+            (t.kind == Tok::Ident && tok(1).kind == Tok::LParen)) {
             n.kind = ExKind::Call;
             ++p_;
             if (!at(Tok::LParen))
-                fail(p_, fmt::format("expected '(' after '{}', found {}", text(n.tok), describe(src_, tok())));
+                fail(p_, fmt::format("expected '(' after '{}', found {}", text(n.tok),
+                                     describe(src_, tok())));
             const bool saved = assignIsEq_;
             args(n.first, n.count);
             assignIsEq_ = saved;
@@ -685,7 +757,8 @@ private:
         const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
         if (r.ec == std::errc::result_out_of_range) {
             // Underflow reads as zero; overflow is an error.
-            if (s.find("e-") != std::string_view::npos || s.find("E-") != std::string_view::npos) return 0;
+            if (s.find("e-") != std::string_view::npos || s.find("E-") != std::string_view::npos)
+                return 0;
             fail(i, fmt::format("number '{}' is too large", s.substr(0, 40)));
         }
         return v;

@@ -1,4 +1,4 @@
-// The parser: tokens -> AST (LANGUAGE.md sections 2-7), by recursive descent.
+// The parser: tokens -> AST (docs/language.md sections 2-7), by recursive descent.
 //
 // Statement kinds are decided from their first tokens as in section 2's table. A syntax
 // error reports the first problem of its statement and resumes at the next statement

@@ -47,23 +47,38 @@ void checkStack(const Graph& g, const Expr& e) {
         int next = d;
         uint32_t target = kNone;
         switch (in.op) {
-            case Op::Const: case Op::Load: case Op::Rand0: next = d + 1; break;
-            case Op::Neg: case Op::Not: case Op::ToBool: check(d >= 1, "unary on empty stack"); break;
-            case Op::Jump: target = in.a; break;
+            case Op::Const:
+            case Op::Load:
+            case Op::Rand0:
+                next = d + 1;
+                break;
+            case Op::Neg:
+            case Op::Not:
+            case Op::ToBool:
+                check(d >= 1, "unary on empty stack");
+                break;
+            case Op::Jump:
+                target = in.a;
+                break;
             case Op::JumpIfZero:
                 check(d >= 1, "branch on empty stack");
                 next = d - 1;
                 target = in.a;
                 break;
-            case Op::Call: case Op::Choose:
+            case Op::Call:
+            case Op::Choose:
                 check(d >= in.argc && in.argc >= 1, "call without its arguments");
                 next = d - in.argc + 1;
                 break;
-            default: check(d >= 2, "binary on a short stack"); next = d - 1; break;
+            default:
+                check(d >= 2, "binary on a short stack");
+                next = d - 1;
+                break;
         }
         check(next <= static_cast<int>(e.maxStack), "stack deeper than maxStack");
         if (target != kNone) {
-            check(target > e.begin + i && target <= e.end, "jump outside the expression or backwards");
+            check(target > e.begin + i && target <= e.end,
+                  "jump outside the expression or backwards");
             int& t = depthAt[target - e.begin];
             check(t < 0 || t == next, "paths meet with different depths");
             t = next;
@@ -79,13 +94,15 @@ void checkStack(const Graph& g, const Expr& e) {
 
 void checkGraph(const Graph& g) {
     check(g.axiom < g.nodes.size(), "axiom");
-    for (const Node& nd : g.nodes) check(nd.firstChild + nd.childCount <= g.edges.size(), "children");
+    for (const Node& nd : g.nodes)
+        check(nd.firstChild + nd.childCount <= g.edges.size(), "children");
     for (NodeId e : g.edges) check(e < g.nodes.size(), "edge");
     for (const Expr& e : g.exprs) {
         check(e.begin < e.end && e.end <= g.code.size(), "expression range");
         checkStack(g, e);
     }
-    for (const Assignment& a : g.assignments) check(a.slot < g.slotCount() && a.value < g.exprs.size(), "assignment");
+    for (const Assignment& a : g.assignments)
+        check(a.slot < g.slotCount() && a.value < g.exprs.size(), "assignment");
     for (ExprId a : g.args) check(a < g.exprs.size(), "argument");
     // Evaluate every expression with all parameters set: exercises the code the
     // builder emitted through the shared evaluator.

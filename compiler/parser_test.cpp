@@ -35,16 +35,24 @@ std::string shape(const Graph& g, NodeId n) {
         return s + ')';
     };
     switch (node.kind) {
-        case NodeKind::Select: return g.modules[node.payload].name;
-        case NodeKind::Transform: return "T" + shape(g, g.child(n));
-        case NodeKind::Calc: return "C" + shape(g, g.child(n));
-        case NodeKind::Paint: return "P" + shape(g, g.child(n));
-        case NodeKind::Union: return kids("U");
-        case NodeKind::Intersection: return kids("I");
-        case NodeKind::Difference: return kids("D");
+        case NodeKind::Select:
+            return g.modules[node.payload].name;
+        case NodeKind::Transform:
+            return "T" + shape(g, g.child(n));
+        case NodeKind::Calc:
+            return "C" + shape(g, g.child(n));
+        case NodeKind::Paint:
+            return "P" + shape(g, g.child(n));
+        case NodeKind::Union:
+            return kids("U");
+        case NodeKind::Intersection:
+            return kids("I");
+        case NodeKind::Difference:
+            return kids("D");
         case NodeKind::Primitive: {
-            static const char* names[] = {"sphere", "cube", "cylinder", "cone", "tetrahedron", "torus",
-                                          "plane", "empty", "tri1", "tri2", "triangle"};
+            static const char* names[] = {"sphere",      "cube",  "cylinder", "cone",
+                                          "tetrahedron", "torus", "plane",    "empty",
+                                          "tri1",        "tri2",  "triangle"};
             return names[static_cast<int>(g.primitives[node.payload].kind)];
         }
     }
@@ -59,7 +67,8 @@ std::string axiomShape(const std::string& axiom) {
 
 // The value of an expression used as a module's selection function, with the given
 // parameters assigned in the frame.
-double value(const std::string& expr, const std::vector<std::pair<std::string, double>>& params = {}) {
+double value(const std::string& expr,
+             const std::vector<std::pair<std::string, double>>& params = {}) {
     std::string text = "S " + expr + "\n1: S -> sphere\n{";
     for (const auto& [name, v] : params) text += name + " = 0;";
     text += "} S\n";
@@ -80,13 +89,13 @@ double value(const std::string& expr, const std::vector<std::pair<std::string, d
 TEST(ParserStatements, KindsAreDecidedByTheirFirstTokens) {
     auto c = compile(
         "camera { angle 30 }\n"
-        "S if(c > 0, 2, 1)\n"          // module declaration
-        "1: S -> d\n"                   // rule, notation A
+        "S if(c > 0, 2, 1)\n"  // module declaration
+        "1: S -> d\n"          // rule, notation A
         "2: S -> {c = c - 1} S\n"
-        "d = sphere ∪ cube\n"           // definition
+        "d = sphere ∪ cube\n"             // definition
         "p1: T(n) : n > 0 -> T(n - 1)\n"  // rule, notation B
         "p2: T(n) -> cone\n"
-        "{c = 2} S ∪ T(3)\n");          // axiom, notation A
+        "{c = 2} S ∪ T(3)\n");  // axiom, notation A
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
     ASSERT_EQ(g.modules.size(), 2u);
@@ -133,7 +142,7 @@ TEST(ExpressionPrecedence, FollowsTheTableOfSection3) {
     EXPECT_EQ(value("2 == 2 < 3"), 0);   // 2 == (2 < 3)
     EXPECT_EQ(value("1 || 0 && 0"), 1);  // && binds tighter than ||
     EXPECT_EQ(value("(1 || 0) && 0"), 0);
-    EXPECT_EQ(value("0 || 3"), 1);       // logical operators give 1 or 0
+    EXPECT_EQ(value("0 || 3"), 1);  // logical operators give 1 or 0
     EXPECT_EQ(value("2 && 3"), 1);
     EXPECT_EQ(value("1 != 2"), 1);
     EXPECT_EQ(value("3 >= 3"), 1);
@@ -197,8 +206,9 @@ TEST(ExpressionPrecedence, EqualsComparesOnlyInNotationBConditions) {
 }
 
 TEST(ExpressionPrecedence, RandomCallSitesAreNumberedAcrossTheFile) {
-    auto c = compile("S choose(1, 2)\n1: S -> {a = rand()} sphere\n2: S -> {b = rand() + rand(3)} T\n"
-                     "T 1\n1: T -> cube\nS\n");
+    auto c = compile(
+        "S choose(1, 2)\n1: S -> {a = rand()} sphere\n2: S -> {b = rand() + rand(3)} T\n"
+        "T 1\n1: T -> cube\nS\n");
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
     EXPECT_EQ(g.randCallSites, 3u);
@@ -248,7 +258,8 @@ TEST(CsgPrecedence, TransformsReadAsInPovRay) {
     ASSERT_EQ(g.nodes[outer].kind, NodeKind::Transform);
     EXPECT_EQ(g.transforms[g.nodes[outer].payload].op, TransformOp::Move);
     EXPECT_EQ(g.transforms[g.nodes[inner].payload].op, TransformOp::RotZ);
-    const Affine m = g.transforms[g.nodes[outer].payload].matrix * g.transforms[g.nodes[inner].payload].matrix;
+    const Affine m =
+        g.transforms[g.nodes[outer].payload].matrix * g.transforms[g.nodes[inner].payload].matrix;
     const Vec3 p = m.point({1, 0, 0});
     EXPECT_NEAR(p.x, 1, 1e-15);
     EXPECT_NEAR(p.y, 1, 1e-15);
@@ -266,20 +277,22 @@ std::string repeat(const std::string& s, int n) {
 TEST(NestingLimit, DeepButReasonableNestingCompiles) {
     const int n = 400;
     EXPECT_EQ(compile(repeat("(", n) + "sphere" + repeat(")", n))->errors(), "");
-    EXPECT_EQ(compile("S " + repeat("(", n) + "1" + repeat(")", n) + "\n1: S -> sphere\nS")->errors(), "");
+    EXPECT_EQ(
+        compile("S " + repeat("(", n) + "1" + repeat(")", n) + "\n1: S -> sphere\nS")->errors(),
+        "");
     EXPECT_EQ(compile(repeat("move(1,0,0) ", n) + "sphere")->errors(), "");
 }
 
 TEST(NestingLimit, HundredThousandLevelsGetOneCleanError) {
     const int n = 100000;
     for (const std::string& text :
-         {repeat("(", n) + "sphere" + repeat(")", n),                      // CSG parentheses
+         {repeat("(", n) + "sphere" + repeat(")", n),                            // CSG parentheses
           "S " + repeat("(", n) + "1" + repeat(")", n) + "\n1: S -> sphere\nS",  // expression
-          "S " + repeat("-", n) + "1\n1: S -> sphere\nS",                  // unary minus
-          "S 2" + repeat("^2", n) + "\n1: S -> sphere\nS",                  // right-associative ^
-          repeat("{c=1} ", n) + "sphere",                                   // C-nodes
-          repeat("{c=1} (", n) + "sphere" + repeat(")", n),                 // C-nodes and parentheses
-          repeat("rotz(1) ", n) + "sphere",                                  // transformations
+          "S " + repeat("-", n) + "1\n1: S -> sphere\nS",                        // unary minus
+          "S 2" + repeat("^2", n) + "\n1: S -> sphere\nS",   // right-associative ^
+          repeat("{c=1} ", n) + "sphere",                    // C-nodes
+          repeat("{c=1} (", n) + "sphere" + repeat(")", n),  // C-nodes and parentheses
+          repeat("rotz(1) ", n) + "sphere",                  // transformations
           "S " + repeat("sin(", n) + "1" + repeat(")", n) + "\n1: S -> sphere\nS"}) {  // calls
         auto c = compile(text);
         EXPECT_FALSE(c->graph);
@@ -309,17 +322,20 @@ TEST(Recovery, EachBadStatementIsReportedAndTheRestIsChecked) {
         "S if(c > 0, 2, 1)\n"
         "1: S -> move(1,2,) sphere\n"  // syntax error
         "2: S -> {c = c - 1} S\n"
-        "x = sphere ∪ ∪ cube\n"        // syntax error
-        "T 1 +\n"                      // syntax error at the end of the line... continues
+        "x = sphere ∪ ∪ cube\n"  // syntax error
+        "T 1 +\n"                // syntax error at the end of the line... continues
         "1: T -> cone\n"
         "U 1\n"
-        "1: U -> nothing\n"            // unknown name: a builder error
+        "1: U -> nothing\n"  // unknown name: a builder error
         "{c = 3} S ∪ U\n");
     EXPECT_FALSE(c->graph);
     const std::string e = c->errors();
-    EXPECT_NE(e.find("t.pcsg:2:18: error: expected an expression, found ')'"), std::string::npos) << e;
+    EXPECT_NE(e.find("t.pcsg:2:18: error: expected an expression, found ')'"), std::string::npos)
+        << e;
     EXPECT_NE(e.find("t.pcsg:4:16: error: expected a primitive"), std::string::npos) << e;
-    EXPECT_NE(e.find("t.pcsg:8:9: error: unknown module or definition 'nothing'"), std::string::npos) << e;
+    EXPECT_NE(e.find("t.pcsg:8:9: error: unknown module or definition 'nothing'"),
+              std::string::npos)
+        << e;
     // Echoes of the dropped statements are not reported: rule 1 of S is missing only
     // because its line failed to parse.
     EXPECT_EQ(e.find("has no rule 1"), std::string::npos) << e;

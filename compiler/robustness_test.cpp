@@ -1,7 +1,7 @@
 // Whatever the input, the compiler returns a graph or clean errors: it never crashes,
-// hangs or exhausts the stack (LANGUAGE.md section 8). Seeded, so failures reproduce.
+// hangs or exhausts the stack (docs/language.md section 8). Seeded, so failures reproduce.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,8 +10,6 @@
 #include <fstream>
 #include <random>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "compiler.h"
 
@@ -24,12 +22,23 @@ void expectWellFormed(const Graph& g) {
     for (const Node& n : g.nodes) {
         ASSERT_LE(n.firstChild + n.childCount, g.edges.size());
         switch (n.kind) {
-            case NodeKind::Select: ASSERT_LT(n.payload, g.modules.size()); break;
-            case NodeKind::Transform: ASSERT_LT(n.payload, g.transforms.size()); break;
-            case NodeKind::Calc: ASSERT_LT(n.payload, g.calcs.size()); break;
-            case NodeKind::Paint: ASSERT_LT(n.payload, g.materials.size()); break;
-            case NodeKind::Primitive: ASSERT_LT(n.payload, g.primitives.size()); break;
-            default: break;
+            case NodeKind::Select:
+                ASSERT_LT(n.payload, g.modules.size());
+                break;
+            case NodeKind::Transform:
+                ASSERT_LT(n.payload, g.transforms.size());
+                break;
+            case NodeKind::Calc:
+                ASSERT_LT(n.payload, g.calcs.size());
+                break;
+            case NodeKind::Paint:
+                ASSERT_LT(n.payload, g.materials.size());
+                break;
+            case NodeKind::Primitive:
+                ASSERT_LT(n.payload, g.primitives.size());
+                break;
+            default:
+                break;
         }
     }
     for (NodeId e : g.edges) ASSERT_LT(e, g.nodes.size());
@@ -79,11 +88,15 @@ TEST(Robustness, RandomBytes) {
 TEST(Robustness, RandomTokenSoup) {
     // Sequences of the language's own words: they reach deep into the parser and builder.
     const char* words[] = {
-        "S", "T", "c", "d", "x", "1", "2", "0.5", ":", "->", "→", "∪", "|", "∩", "&", "\\", "(", ")",
-        "{", "}", "=", "==", "<", ">", "+", "-", "*", "/", "^", "!", "&&", "||", ",", ";", "\n",
-        "\n", "if", "rand", "choose", "sin", "min", "move", "rotz", "uscale", "flipxz", "matrix",
-        "sphere", "tri1", "torus", "triangle", "paint", "material", "camera", "light", "background",
-        "settings", "<1,2,3>", "location", "angle", "seed", "#define M", "M", "p1", "w", "pi", "e"};
+        "S",       "T",        "c",     "d",        "x",         "1",      "2",          "0.5",
+        ":",       "->",       "→",     "∪",        "|",         "∩",      "&",          "\\",
+        "(",       ")",        "{",     "}",        "=",         "==",     "<",          ">",
+        "+",       "-",        "*",     "/",        "^",         "!",      "&&",         "||",
+        ",",       ";",        "\n",    "\n",       "if",        "rand",   "choose",     "sin",
+        "min",     "move",     "rotz",  "uscale",   "flipxz",    "matrix", "sphere",     "tri1",
+        "torus",   "triangle", "paint", "material", "camera",    "light",  "background", "settings",
+        "<1,2,3>", "location", "angle", "seed",     "#define M", "M",      "p1",         "w",
+        "pi",      "e"};
     const size_t n = sizeof(words) / sizeof(words[0]);
     std::mt19937 rng(99);
     for (int i = 0; i < 3000; ++i) {
@@ -122,9 +135,15 @@ TEST(Robustness, MutatedValidScenes) {
         for (int k = 0; k < edits; ++k) {
             const size_t at = rng() % text.size();
             switch (rng() % 3) {
-                case 0: text.erase(at, 1 + rng() % 3); break;
-                case 1: text.insert(at, 1, "(){}<>,;:=|&\\-+*/^!#\n0aS"[rng() % 25]); break;
-                default: text[at] = static_cast<char>(rng()); break;
+                case 0:
+                    text.erase(at, 1 + rng() % 3);
+                    break;
+                case 1:
+                    text.insert(at, 1, "(){}<>,;:=|&\\-+*/^!#\n0aS"[rng() % 25]);
+                    break;
+                default:
+                    text[at] = static_cast<char>(rng());
+                    break;
             }
         }
         SCOPED_TRACE(text);
@@ -134,8 +153,9 @@ TEST(Robustness, MutatedValidScenes) {
 }
 
 TEST(Robustness, EmptyInputsGetOneError) {
-    for (const std::string& text : {std::string(), std::string(" \n\t\r\n"), std::string("// nothing\n/* at all */"),
-                                    std::string("\xEF\xBB\xBF")}) {
+    for (const std::string& text :
+         {std::string(), std::string(" \n\t\r\n"), std::string("// nothing\n/* at all */"),
+          std::string("\xEF\xBB\xBF")}) {
         Diagnostics d;
         EXPECT_FALSE(compileSource("e.pcsg", text, d));
         ASSERT_EQ(d.errors().size(), 1u);
@@ -157,8 +177,7 @@ TEST(Robustness, TooManyErrorsStopAtTheLimit) {
 // was evaluated without a frame here and crashed (found by the parser fuzzer).
 TEST(Robustness, ErrorsPastTheLimitStillCount) {
     std::string text = "{n = 1} S\nS 1\n1: S -> sphere\n";
-    for (int i = 0; i < 60; ++i)
-        text += "light { position <10, n - 20, 30>  color <1, 1, 1> }\n";
+    for (int i = 0; i < 60; ++i) text += "light { position <10, n - 20, 30>  color <1, 1, 1> }\n";
     Diagnostics d;
     EXPECT_FALSE(compileSource("full.pcsg", text, d));
     ASSERT_EQ(d.errors().size(), Diagnostics::kMaxErrors);
@@ -176,7 +195,9 @@ TEST(Robustness, ALargeGeneratedFileCompiles) {
         text += fmt::format("M{} if(n > 0, 2, 1)\n", i);
         text += fmt::format("1: M{} -> d{}\n", i, i);
         if (i + 1 < modules)
-            text += fmt::format("2: M{} -> d{} ∪ {{n = n - 0.00001}} move(0, 0, 1.5) uscale(0.9) M{}\n", i, i, i + 1);
+            text +=
+                fmt::format("2: M{} -> d{} ∪ {{n = n - 0.00001}} move(0, 0, 1.5) uscale(0.9) M{}\n",
+                            i, i, i + 1);
         else
             text += fmt::format("2: M{} -> cube\n", i);
         text += fmt::format("d{} = move({}, 0, 0) (sphere ∩ cube) \\ cylinder\n", i, i % 7);
@@ -192,9 +213,7 @@ TEST(Robustness, ALargeGeneratedFileCompiles) {
 TEST(Robustness, FilesOverTheSizeLimitAreRejectedWithoutReading) {
     const std::filesystem::path path =
         std::filesystem::temp_directory_path() / fmt::format("pcsg_huge_{}.pcsg", ::getpid());
-    {
-        std::ofstream out(path);
-    }
+    { std::ofstream out(path); }
     std::filesystem::resize_file(path, (size_t(300) << 20));  // sparse: no disk space used
     std::string storage;
     Diagnostics d;
@@ -213,7 +232,9 @@ TEST(Robustness, UnreadableFilesAreDiagnostics) {
     Diagnostics d;
     EXPECT_FALSE(compileFile("/nonexistent/dir/scene.pcsg", storage, d));
     ASSERT_EQ(d.errors().size(), 1u);
-    EXPECT_EQ(d.format(), "/nonexistent/dir/scene.pcsg: error: cannot open the file: No such file or directory\n");
+    EXPECT_EQ(
+        d.format(),
+        "/nonexistent/dir/scene.pcsg: error: cannot open the file: No such file or directory\n");
     Diagnostics d2;
     EXPECT_FALSE(compileFile(std::filesystem::temp_directory_path().string(), storage, d2));
     ASSERT_EQ(d2.errors().size(), 1u);
@@ -229,7 +250,8 @@ TEST(Robustness, ALongLineIsShownAroundTheColumn) {
     ASSERT_EQ(d.errors().size(), 1u);
     const std::string out = d.format();
     EXPECT_LT(out.size(), 600u) << out.substr(0, 600);
-    EXPECT_EQ(out.rfind("long.pcsg:1:500007: error: unexpected character '$'", 0), 0u) << out.substr(0, 300);
+    EXPECT_EQ(out.rfind("long.pcsg:1:500007: error: unexpected character '$'", 0), 0u)
+        << out.substr(0, 300);
     // The caret is under the '$' in the shown window.
     std::vector<std::string> lines;
     for (size_t p = 0, q; p < out.size(); p = q + 1) {

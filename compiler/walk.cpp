@@ -49,7 +49,8 @@ void nodeInfo(const Graph& g, NodeId n, bool& usesPath, std::vector<uint8_t>& re
                     exprInfo(g, g.args[p.firstArg + i], usesPath, readSet);
             break;
         }
-        default: break;
+        default:
+            break;
     }
 }
 
@@ -60,7 +61,8 @@ void nodeInfo(const Graph& g, NodeId n, bool& usesPath, std::vector<uint8_t>& re
 // the count stays correct, only slower.
 std::vector<ModuleDependencies> moduleDependencies(const Graph& g) {
     std::vector<ModuleDependencies> info(g.modules.size());
-    const uint64_t work = static_cast<uint64_t>(g.modules.size()) * (g.nodes.size() + g.edges.size());
+    const uint64_t work =
+        static_cast<uint64_t>(g.modules.size()) * (g.nodes.size() + g.edges.size());
     if (work > 50'000'000) return info;
     std::vector<uint32_t> seen(g.nodes.size(), UINT32_MAX);
     std::vector<uint8_t> readSet(g.slotCount());

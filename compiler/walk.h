@@ -42,23 +42,26 @@ enum class TreeKind : uint8_t { Primitive, Union, Intersection, Difference };
 // The argument values a primitive kind carries into an expanded tree.
 constexpr uint32_t storedArgs(PrimitiveKind k) {
     switch (k) {
-        case PrimitiveKind::Torus: return 2;
-        case PrimitiveKind::Triangle: return 9;
-        default: return 0;
+        case PrimitiveKind::Torus:
+            return 2;
+        case PrimitiveKind::Triangle:
+            return 9;
+        default:
+            return 0;
     }
 }
 
 // One node being visited: the traversal state the one semantics carries down.
 struct WalkEntry {
     NodeId node;
-    uint32_t depth;       // S-nodes passed on the path before this node
-    uint32_t material;    // the innermost paint so far (0: default)
-    uint32_t next;        // progress: operators: children begun; unary nodes: 1 once entered
-    size_t frame;         // offset of the incoming parameter frame in the arena
-    size_t resultBase;    // size of the result stack when an operator began
-    uint64_t path;        // the instance path
-    Affine world;         // maps this node's frame to the start node's frame
-    size_t mark[4];       // the sink's bookkeeping for operators
+    uint32_t depth;     // S-nodes passed on the path before this node
+    uint32_t material;  // the innermost paint so far (0: default)
+    uint32_t next;      // progress: operators: children begun; unary nodes: 1 once entered
+    size_t frame;       // offset of the incoming parameter frame in the arena
+    size_t resultBase;  // size of the result stack when an operator began
+    uint64_t path;      // the instance path
+    Affine world;       // maps this node's frame to the start node's frame
+    size_t mark[4];     // the sink's bookkeeping for operators
 };
 
 // Where a walk starts: the axiom with an empty frame, or any node with a given state.
@@ -72,7 +75,7 @@ struct WalkStart {
 
 template <class Sink>
 class Walker {
-public:
+  public:
     using Result = typename Sink::Result;
 
     Walker(const Graph& g, Sink& sink)
@@ -116,7 +119,7 @@ public:
         return results_.back();
     }
 
-private:
+  private:
     static constexpr bool localSelectFrames() {
         if constexpr (requires { Sink::kLocalSelectFrames; })
             return Sink::kLocalSelectFrames;
@@ -237,8 +240,8 @@ private:
                                       : node.kind == NodeKind::Intersection ? TreeKind::Intersection
                                                                             : TreeKind::Difference;
                 const size_t base = e.resultBase;
-                const Result r = sink_.endOperator(kind, results_.data() + base,
-                                                   static_cast<uint32_t>(results_.size() - base), e);
+                const Result r = sink_.endOperator(
+                    kind, results_.data() + base, static_cast<uint32_t>(results_.size() - base), e);
                 results_.resize(base);
                 results_.push_back(r);
                 stack_.pop_back();

@@ -2,12 +2,12 @@
 // shared walk over the graph (compiler/walk.h), which follows the one semantics of eval.h.
 #include "expander.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <bit>
 #include <cstring>
 #include <unordered_map>
-
-#include <fmt/format.h>
 
 #include "eval.h"
 #include "walk.h"
@@ -20,7 +20,9 @@ namespace pcsg {
 namespace {
 
 constexpr uint64_t kSat = UINT64_MAX;
-constexpr uint64_t addSat(uint64_t a, uint64_t b) { return a > kSat - b ? kSat : a + b; }
+constexpr uint64_t addSat(uint64_t a, uint64_t b) {
+    return a > kSat - b ? kSat : a + b;
+}
 constexpr uint64_t mulSat(uint64_t a, uint64_t b) {
     return (a != 0 && b > kSat / a) ? kSat : a * b;
 }
@@ -36,7 +38,8 @@ size_t ExpandedTree::bytes() const {
 size_t ExpansionCount::treeBytes() const {
     uint64_t b = sizeof(ExpandedTree);
     b = addSat(b, mulSat(nodes, sizeof(TreeNode)));
-    b = addSat(b, mulSat(nodes > 0 ? nodes - 1 : 0, sizeof(uint32_t)));  // every non-root node is one child
+    b = addSat(b, mulSat(nodes > 0 ? nodes - 1 : 0,
+                         sizeof(uint32_t)));  // every non-root node is one child
     b = addSat(b, mulSat(primitives, sizeof(TreePrimitive)));
     b = addSat(b, mulSat(args, sizeof(double)));
     return static_cast<size_t>(b);
@@ -80,7 +83,7 @@ struct KeyHash {
 };
 
 class CountSink {
-public:
+  public:
     using Result = Count;
     static constexpr size_t kMaxMemo = 1 << 18;
 
@@ -140,7 +143,7 @@ public:
         return sum;
     }
 
-private:
+  private:
     bool makeKey(NodeId n, uint32_t depth, const double* frame) {
         const uint32_t m = g_.nodes[n].payload;
         if (!modules_[m].memoisable) return false;
@@ -171,7 +174,7 @@ private:
 struct OverBudget {};
 
 class TreeSink {
-public:
+  public:
     using Result = uint32_t;  // a node id, or kNone for nothing
 
     TreeSink(ExpandedTree& t, uint64_t maxNodes) : t_(t), maxNodes_(maxNodes) {}
@@ -181,8 +184,8 @@ public:
     bool lookup(NodeId, uint32_t, const double*, uint64_t, Result&) { return false; }
     void store(NodeId, uint32_t, const double*, uint64_t, Result) {}
 
-    Result primitive(PrimitiveKind kind, const Affine& world, uint32_t material,
-                     const double* args, uint32_t argc) {
+    Result primitive(PrimitiveKind kind, const Affine& world, uint32_t material, const double* args,
+                     uint32_t argc) {
         if (kind == PrimitiveKind::Empty) return kNone;
         reserveNode();
         TreePrimitive p;
@@ -224,7 +227,7 @@ public:
         return static_cast<uint32_t>(t_.nodes.size() - 1);
     }
 
-private:
+  private:
     void reserveNode() {
         if (t_.nodes.size() >= maxNodes_) throw OverBudget{};
     }
@@ -271,9 +274,10 @@ ExpandedTree expand(const Graph& g, const ExpandOptions& options) {
     const uint64_t maxNodes = std::min<uint64_t>(options.maxNodes, UINT32_MAX - 1);
     // The counting pass may work somewhat longer than the expansion would (so that an
     // expansion over budget can say exactly how large it would be): a few seconds at most.
-    const uint64_t visits = options.countVisits
-                                ? options.countVisits
-                                : std::max<uint64_t>(addSat(mulSat(maxNodes, 16), 1'000'000), 100'000'000);
+    const uint64_t visits =
+        options.countVisits
+            ? options.countVisits
+            : std::max<uint64_t>(addSat(mulSat(maxNodes, 16), 1'000'000), 100'000'000);
 
     // First count (cheap where memoisable): an expansion over budget fails before it
     // allocates anything, with the exact figure, and one within budget gets its arrays

@@ -20,12 +20,12 @@
 
 namespace pcsg {
 
-// One primitive of the expanded tree: its kind in its own coordinates (LANGUAGE.md
+// One primitive of the expanded tree: its kind in its own coordinates (docs/language.md
 // section 5), the accumulated object-to-world map, its material and its arguments.
 struct TreePrimitive {
-    Affine toWorld;               // p_world = L p_object + t
-    uint32_t material = 0;        // index into Graph::materials (0: the default)
-    uint32_t firstArg = kNone;    // ExpandedTree::args: torus R r, triangle 9 coordinates
+    Affine toWorld;             // p_world = L p_object + t
+    uint32_t material = 0;      // index into Graph::materials (0: the default)
+    uint32_t firstArg = kNone;  // ExpandedTree::args: torus R r, triangle 9 coordinates
     PrimitiveKind kind = PrimitiveKind::Sphere;
 };
 
@@ -78,9 +78,9 @@ struct CountOptions {
 // where the expansion would.
 ExpansionCount countExpansion(const Graph& g, const CountOptions& options = {});
 
-// The node budget was exceeded (LANGUAGE.md has no such error: it is the exporter's).
+// The node budget was exceeded (docs/language.md has no such error: it is the exporter's).
 class BudgetError : public std::runtime_error {
-public:
+  public:
     BudgetError(std::string message, uint64_t limit, std::optional<uint64_t> needed);
     uint64_t limit;                  // --max-nodes
     std::optional<uint64_t> needed;  // the nodes the tree would need, when known

@@ -15,7 +15,9 @@ namespace {
 
 using namespace testgraphs;
 
-uint64_t pow4(int n) { return uint64_t{1} << (2 * n); }
+uint64_t pow4(int n) {
+    return uint64_t{1} << (2 * n);
+}
 
 ExpandOptions budget(uint64_t maxNodes, uint64_t countVisits = 0) {
     ExpandOptions o;
@@ -50,7 +52,8 @@ TEST(Expander, SierpinskiCornersAreTheTetrahedronsVertices) {
     // Order 1: four tetrahedra of half size at the centres (±0.5, ...).
     const ExpandedTree t = expand(sierpinski(1));
     std::set<std::tuple<double, double, double>> centres;
-    for (const TreePrimitive& p : t.primitives) centres.insert({p.toWorld.t.x, p.toWorld.t.y, p.toWorld.t.z});
+    for (const TreePrimitive& p : t.primitives)
+        centres.insert({p.toWorld.t.x, p.toWorld.t.y, p.toWorld.t.z});
     const std::set<std::tuple<double, double, double>> expected = {
         {0.5, 0.5, 0.5}, {-0.5, -0.5, 0.5}, {0.5, -0.5, -0.5}, {-0.5, 0.5, -0.5}};
     EXPECT_EQ(centres, expected);
@@ -65,7 +68,8 @@ TEST(Expander, SierpinskiCornersAreTheTetrahedronsVertices) {
 TEST(Expander, CountingIsMemoisedForDeterministicSystems) {
     const auto start = std::chrono::steady_clock::now();
     const ExpansionCount c = countExpansion(sierpinski(12));
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_TRUE(c.complete);
     EXPECT_EQ(c.primitives, pow4(12));
     EXPECT_EQ(c.nodes, pow4(12) + (pow4(12) - 1) / 3);
@@ -202,8 +206,9 @@ TEST(Expander, TransformsComposeInTextOrderAndTheInnermostPaintWins) {
     g.materials.push_back(Material{"one"});
     g.materials.push_back(Material{"two"});
     const NodeId sph = primitive(g, PrimitiveKind::Sphere);
-    g.axiom = paint(g, 1, transform(g, TransformOp::Move, {1, 0, 0},
-                                   paint(g, 2, transform(g, TransformOp::UScale, {2}, sph))));
+    g.axiom = paint(g, 1,
+                    transform(g, TransformOp::Move, {1, 0, 0},
+                              paint(g, 2, transform(g, TransformOp::UScale, {2}, sph))));
     const ExpandedTree t = expand(g);
     ASSERT_EQ(t.primitives.size(), 1u);
     const TreePrimitive& p = t.primitives[0];
@@ -217,11 +222,13 @@ TEST(Expander, SiblingsDoNotSeeEachOthersAssignments) {
     Graph g;
     defaultScene(g);
     const Slot c = g.slot("c");
-    const NodeId a = calc(g, {{c, g.addConstant(5)}},
-                          transformOf(g, TransformOp::Move, {g.addLoad(c), g.addConstant(0), g.addConstant(0)},
-                                      primitive(g, PrimitiveKind::Sphere)));
-    const NodeId b = transformOf(g, TransformOp::Move, {g.addLoad(c), g.addConstant(0), g.addConstant(0)},
-                                 primitive(g, PrimitiveKind::Cube));
+    const NodeId a =
+        calc(g, {{c, g.addConstant(5)}},
+             transformOf(g, TransformOp::Move, {g.addLoad(c), g.addConstant(0), g.addConstant(0)},
+                         primitive(g, PrimitiveKind::Sphere)));
+    const NodeId b =
+        transformOf(g, TransformOp::Move, {g.addLoad(c), g.addConstant(0), g.addConstant(0)},
+                    primitive(g, PrimitiveKind::Cube));
     g.axiom = calc(g, {{c, g.addConstant(1)}}, g.addNode(NodeKind::Union, kNone, {a, b}));
     const ExpandedTree t = expand(g);
     ASSERT_EQ(t.primitives.size(), 2u);
@@ -256,7 +263,8 @@ TEST(Expander, EmptyFoldsAwayAndCountsAgree) {
         const NodeId inner = g.addNode(k.kind, kNone, ops);
         g.axiom = g.addNode(NodeKind::Union, kNone, {inner, primitive(g, P::Torus, {2, 0.5})});
         const ExpandedTree t = expand(g);
-        const size_t outer = k.prims > 0 ? 1 : 0;  // the outer union survives only with two operands
+        const size_t outer =
+            k.prims > 0 ? 1 : 0;  // the outer union survives only with two operands
         EXPECT_EQ(t.primitives.size(), k.prims + 1) << k.name;
         EXPECT_EQ(t.nodes.size(), k.nodes + 1 + outer) << k.name;
         EXPECT_EQ(t.args.size(), 2u) << k.name;
@@ -271,7 +279,8 @@ TEST(Expander, EmptyFoldsAwayAndCountsAgree) {
                 EXPECT_LT(t.childrenOf(n)[i], n) << k.name;
                 ++parents[t.childrenOf(n)[i]];
             }
-        for (uint32_t n = 0; n < t.nodes.size(); ++n) EXPECT_EQ(parents[n], n == t.root ? 0 : 1) << k.name;
+        for (uint32_t n = 0; n < t.nodes.size(); ++n)
+            EXPECT_EQ(parents[n], n == t.root ? 0 : 1) << k.name;
     }
 }
 
@@ -283,9 +292,10 @@ TEST(Expander, TorusAndTriangleArgumentsAreEvaluatedPerInstance) {
     std::vector<ExprId> tri;
     for (double v : {0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}) tri.push_back(g.addConstant(v));
     tri.push_back(g.addLoad(r));
-    const NodeId u = g.addNode(NodeKind::Union, kNone,
-                               {primitiveOf(g, PrimitiveKind::Torus, {g.addConstant(1), g.addLoad(r)}),
-                                primitiveOf(g, PrimitiveKind::Triangle, tri)});
+    const NodeId u =
+        g.addNode(NodeKind::Union, kNone,
+                  {primitiveOf(g, PrimitiveKind::Torus, {g.addConstant(1), g.addLoad(r)}),
+                   primitiveOf(g, PrimitiveKind::Triangle, tri)});
     g.axiom = calc(g, {{r, g.addConstant(0.25)}}, u);
     const ExpandedTree t = expand(g);
     ASSERT_EQ(t.primitives.size(), 2u);
@@ -300,7 +310,8 @@ TEST(Expander, DeepGraphsNeedNoDeepCStack) {
     defaultScene(g);
     NodeId n = primitive(g, PrimitiveKind::Sphere);
     for (int i = 0; i < 50000; ++i) n = transform(g, TransformOp::Move, {1e-6, 0, 0}, n);
-    for (int i = 0; i < 50000; ++i) n = g.addNode(NodeKind::Union, kNone, {n, primitive(g, PrimitiveKind::Cube)});
+    for (int i = 0; i < 50000; ++i)
+        n = g.addNode(NodeKind::Union, kNone, {n, primitive(g, PrimitiveKind::Cube)});
     g.axiom = n;
     const ExpandedTree t = expand(g);
     EXPECT_EQ(t.primitives.size(), 50001u);

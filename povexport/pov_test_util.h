@@ -17,11 +17,13 @@
 
 namespace pcsg::povtest {
 
-inline bool povrayInstalled() { return std::system("command -v povray >/dev/null 2>&1") == 0; }
+inline bool povrayInstalled() {
+    return std::system("command -v povray >/dev/null 2>&1") == 0;
+}
 
 struct PovRun {
     int status = -1;
-    std::string log;            // POV-Ray's console output (stdout and stderr)
+    std::string log;  // POV-Ray's console output (stdout and stderr)
     int width = 0, height = 0;
     std::vector<unsigned char> rgb;  // 8-bit RGB, row 0 at the top
     double seconds = 0;
@@ -31,12 +33,14 @@ struct PovRun {
         std::istringstream in(log);
         std::string line, out;
         while (std::getline(in, line))
-            if (line.find("Warning:") != std::string::npos || line.find("Error") != std::string::npos ||
-                line.find("error") != std::string::npos)
+            if (line.find("Warning:") != std::string::npos ||
+                line.find("Error") != std::string::npos || line.find("error") != std::string::npos)
                 out += line + "\n";
         return out;
     }
-    unsigned char at(int x, int y, int c) const { return rgb[(static_cast<size_t>(y) * width + x) * 3 + c]; }
+    unsigned char at(int x, int y, int c) const {
+        return rgb[(static_cast<size_t>(y) * width + x) * 3 + c];
+    }
 };
 
 inline std::vector<unsigned char> readPpm(const std::string& path, int& w, int& h) {
@@ -80,7 +84,8 @@ struct PovJob {
 // running them side by side costs little CPU and saves most of the wall time).
 inline std::vector<PovRun> renderPovMany(const std::vector<PovJob>& jobs) {
     namespace fs = std::filesystem;
-    const fs::path root = fs::path(::testing::TempDir()) / ("pcsg_pov_" + std::to_string(::getpid()));
+    const fs::path root =
+        fs::path(::testing::TempDir()) / ("pcsg_pov_" + std::to_string(::getpid()));
     fs::remove_all(root);
     std::string script = "#!/bin/sh\n";
     for (size_t i = 0; i < jobs.size(); ++i) {
@@ -90,13 +95,15 @@ inline std::vector<PovRun> renderPovMany(const std::vector<PovJob>& jobs) {
         std::ofstream(dir / "scene.pov") << jobs[i].text;
         script += "(cd '" + dir.string() + "' && HOME='" + dir.string() +
                   "' povray +Iscene.pov +Oout.ppm +FP +W" + std::to_string(jobs[i].width) + " +H" +
-                  std::to_string(jobs[i].height) + " -D -A -V +WT1 >log.txt 2>&1; echo $? >status.txt) &\n";
+                  std::to_string(jobs[i].height) +
+                  " -D -A -V +WT1 >log.txt 2>&1; echo $? >status.txt) &\n";
     }
     script += "wait\n";
     std::ofstream(root / "run.sh") << script;
     const auto start = std::chrono::steady_clock::now();
     const int rc = std::system(("sh '" + (root / "run.sh").string() + "'").c_str());
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::vector<PovRun> runs(jobs.size());
     for (size_t i = 0; i < jobs.size(); ++i) {
         const fs::path dir = root / (std::to_string(i) + "_" + jobs[i].name);

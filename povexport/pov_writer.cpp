@@ -1,13 +1,13 @@
 // The POV-Ray 3.7 writer: see pov_writer.h for the mapping.
 #include "pov_writer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <stdexcept>
 #include <string_view>
-
-#include <fmt/format.h>
 
 namespace pcsg {
 
@@ -65,11 +65,13 @@ Box primitiveBox(const ExpandedTree& t, const TreePrimitive& p) {
                 b.hi[i] = m.t[i] + e;
             }
             return b;
-        case PrimitiveKind::Cube: return transformBox(m, Box{{-1, -1, -1}, {1, 1, 1}});
+        case PrimitiveKind::Cube:
+            return transformBox(m, Box{{-1, -1, -1}, {1, 1, 1}});
         case PrimitiveKind::Tetrahedron:
             for (const Vec3& v : kTetraVertices) b.extend(m.point(v));
             return b;
-        case PrimitiveKind::Cylinder: return unite(diskBox(m, 0), diskBox(m, 1));
+        case PrimitiveKind::Cylinder:
+            return unite(diskBox(m, 0), diskBox(m, 1));
         case PrimitiveKind::Cone: {
             b = diskBox(m, 0);
             b.extend(m.point({0, 0, 1}));
@@ -97,7 +99,8 @@ Box primitiveBox(const ExpandedTree& t, const TreePrimitive& p) {
             for (const Vec3& v : c) b.extend(v);
             return b;
         }
-        case PrimitiveKind::Empty: return b;
+        case PrimitiveKind::Empty:
+            return b;
     }
     return b;
 }
@@ -116,7 +119,9 @@ std::vector<Box> nodeBoxes(const ExpandedTree& t) {
     for (uint32_t n = 0; n < t.nodes.size(); ++n) {
         const TreeNode& node = t.nodes[n];
         switch (node.kind) {
-            case TreeKind::Primitive: boxes[n] = primitiveBox(t, t.primitiveOf(n)); break;
+            case TreeKind::Primitive:
+                boxes[n] = primitiveBox(t, t.primitiveOf(n));
+                break;
             case TreeKind::Union: {
                 Box b;
                 for (uint32_t i = 0; i < node.count; ++i) b.extend(boxes[t.childrenOf(n)[i]]);
@@ -125,11 +130,14 @@ std::vector<Box> nodeBoxes(const ExpandedTree& t) {
             }
             case TreeKind::Intersection: {
                 Box b = Box::everything();
-                for (uint32_t i = 0; i < node.count; ++i) b = intersect(b, boxes[t.childrenOf(n)[i]]);
+                for (uint32_t i = 0; i < node.count; ++i)
+                    b = intersect(b, boxes[t.childrenOf(n)[i]]);
                 boxes[n] = b;
                 break;
             }
-            case TreeKind::Difference: boxes[n] = boxes[t.childrenOf(n)[0]]; break;
+            case TreeKind::Difference:
+                boxes[n] = boxes[t.childrenOf(n)[0]];
+                break;
         }
     }
     return boxes;
@@ -140,7 +148,7 @@ std::vector<Box> nodeBoxes(const ExpandedTree& t) {
 
 // Streams text through a buffer of bounded size.
 class Out {
-public:
+  public:
     explicit Out(std::ostream& os) : os_(os) {}
     ~Out() = default;
 
@@ -174,7 +182,7 @@ public:
     }
     uint64_t written() const { return written_ + buf_.size(); }
 
-private:
+  private:
     std::ostream& os_;
     fmt::memory_buffer buf_;
     uint64_t written_ = 0;
@@ -267,7 +275,8 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
     // The tetrahedron with vertices (1,1,1), (-1,-1,1), (1,-1,-1), (-1,1,-1): the face
     // opposite vertex v lies in the plane -v.p = 1, its inside is -v.p <= 1.
     bool tetra = false;
-    for (const TreePrimitive& p : t.primitives) tetra = tetra || p.kind == PrimitiveKind::Tetrahedron;
+    for (const TreePrimitive& p : t.primitives)
+        tetra = tetra || p.kind == PrimitiveKind::Tetrahedron;
     if (tetra) {
         const double s = 1 / std::sqrt(3.0);
         o.put("\n#declare PcsgTetrahedron = intersection {{\n");
@@ -278,7 +287,9 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
             o.num(s);
             o.put(" }}\n");
         }
-        o.put("  bounded_by {{ box {{ <-1.000001,-1.000001,-1.000001>, <1.000001,1.000001,1.000001> }} }}\n}}\n");
+        o.put(
+            "  bounded_by {{ box {{ <-1.000001,-1.000001,-1.000001>, <1.000001,1.000001,1.000001> "
+            "}} }}\n}}\n");
     }
     o.put("\n");
 }
@@ -294,7 +305,8 @@ Affine torusFrame() {
 }
 
 // One primitive on one line. Returns false when it was left out.
-bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, const std::string& indent) {
+bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p,
+                  const std::string& indent) {
     const auto tex = [&] { o.put(" texture{{M{}}}", p.material); };
     switch (p.kind) {
         case PrimitiveKind::Sphere:
@@ -350,7 +362,8 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, const s
             tex();
             break;
         }
-        case PrimitiveKind::Empty: return false;
+        case PrimitiveKind::Empty:
+            return false;
     }
     o.put("}}\n");
     return true;
@@ -362,20 +375,24 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, const s
 
 struct Item {
     bool group = false;
-    uint32_t node = 0;       // a tree node
-    size_t lo = 0, hi = 0;   // a group: members[lo, hi)
-    uint32_t next = 0;       // children written so far
+    uint32_t node = 0;                              // a tree node
+    size_t lo = 0, hi = 0;                          // a group: members[lo, hi)
+    uint32_t next = 0;                              // children written so far
     std::vector<std::pair<size_t, size_t>> slices;  // a big group's sub-groups
     bool ownsMembers = false;  // this item pushed members[lo, hi) and pops them at the end
     Box box;
 };
 
 class TreeWriter {
-public:
+  public:
     static constexpr size_t kMaxNesting = 256;  // deeper unions are flattened and regrouped
 
     TreeWriter(Out& o, const ExpandedTree& t, const PovOptions& opt, PovWriteStats& stats)
-        : o_(o), t_(t), opt_(opt), stats_(stats), boxes_(nodeBoxes(t)),
+        : o_(o),
+          t_(t),
+          opt_(opt),
+          stats_(stats),
+          boxes_(nodeBoxes(t)),
           maxChildren_(std::max<uint32_t>(opt.maxUnionChildren, 2)) {}
 
     void write(uint32_t root) {
@@ -383,14 +400,16 @@ public:
         while (!stack_.empty()) step();
     }
 
-private:
+  private:
     Item nodeItem(uint32_t n) {
         Item it;
         it.node = n;
         return it;
     }
 
-    std::string indent() const { return std::string(std::min<size_t>(stack_.size() - 1, 40) * 1, ' '); }
+    std::string indent() const {
+        return std::string(std::min<size_t>(stack_.size() - 1, 40) * 1, ' ');
+    }
 
     void step() {
         Item& it = stack_.back();
@@ -405,7 +424,8 @@ private:
                 return;
             }
             const bool deep = stack_.size() > kMaxNesting;
-            if (node.kind == TreeKind::Union && it.next == 0 && (node.count > maxChildren_ || deep)) {
+            if (node.kind == TreeKind::Union && it.next == 0 &&
+                (node.count > maxChildren_ || deep)) {
                 // Regroup: the operands become a group item over a run of `members`. Deep
                 // in the tree (a long chain of unions from a linear recursion), the
                 // union's whole union-subtree is flattened first: POV-Ray's parser
@@ -415,7 +435,8 @@ private:
                 if (deep)
                     flattenUnion(n);
                 else
-                    members_.insert(members_.end(), t_.childrenOf(n), t_.childrenOf(n) + node.count);
+                    members_.insert(members_.end(), t_.childrenOf(n),
+                                    t_.childrenOf(n) + node.count);
                 stack_.pop_back();
                 Item g;
                 g.group = true;
@@ -509,13 +530,15 @@ private:
         int axis = 0;
         for (int a = 1; a < 3; ++a)
             if (centres.hi[a] - centres.lo[a] > centres.hi[axis] - centres.lo[axis]) axis = a;
-        std::stable_sort(members_.begin() + static_cast<std::ptrdiff_t>(it.lo),
-                         members_.begin() + static_cast<std::ptrdiff_t>(it.hi),
-                         [&](uint32_t a, uint32_t b) { return centreOf(a)[axis] < centreOf(b)[axis]; });
+        std::stable_sort(
+            members_.begin() + static_cast<std::ptrdiff_t>(it.lo),
+            members_.begin() + static_cast<std::ptrdiff_t>(it.hi),
+            [&](uint32_t a, uint32_t b) { return centreOf(a)[axis] < centreOf(b)[axis]; });
         const size_t n = it.hi - it.lo;
         const size_t parts = std::min<size_t>(maxChildren_, (n + maxChildren_ - 1) / maxChildren_);
         const size_t size = (n + parts - 1) / parts;
-        for (size_t s = it.lo; s < it.hi; s += size) it.slices.push_back({s, std::min(it.hi, s + size)});
+        for (size_t s = it.lo; s < it.hi; s += size)
+            it.slices.push_back({s, std::min(it.hi, s + size)});
     }
 
     Vec3 centreOf(uint32_t n) const {
@@ -523,7 +546,8 @@ private:
         Vec3 c;
         for (int i = 0; i < 3; ++i) {
             // Unbounded operands (planes) sort by their finite side, or as 0.
-            const double lo = std::isfinite(b.lo[i]) ? b.lo[i] : (std::isfinite(b.hi[i]) ? b.hi[i] : 0);
+            const double lo =
+                std::isfinite(b.lo[i]) ? b.lo[i] : (std::isfinite(b.hi[i]) ? b.hi[i] : 0);
             const double hi = std::isfinite(b.hi[i]) ? b.hi[i] : lo;
             c[i] = b.isEmpty() ? 0 : 0.5 * (lo + hi);
         }

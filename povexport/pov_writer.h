@@ -1,7 +1,7 @@
 // The POV-Ray 3.7 writer: the expanded tree as scene description text that POV-Ray
 // renders as the same picture as the native tracer, and fast.
 //
-// Mapping (LANGUAGE.md sections 5 and 7):
+// Mapping (docs/language.md sections 5 and 7):
 //  - Geometry keeps our coordinates. Each primitive is POV-Ray's own object with the
 //    accumulated object-to-world map as `matrix <...>`: our Affine is p' = L p + t
 //    (column vectors), POV-Ray's matrix is p' = p·M + t (row vectors), so M = L^T.
@@ -39,7 +39,7 @@
 //
 // `angle` is the horizontal field of view, the image's aspect the vertical one; POV-Ray
 // applies look_at and angle after the other items. With sky <0,0,1> looking along +y,
-// +x is on the right of the image, as LANGUAGE.md section 7 says (checked against
+// +x is on the right of the image, as docs/language.md section 7 says (checked against
 // POV-Ray in pov_writer_test.cpp: the silhouettes of asymmetric objects match an
 // independent pin-hole projection).
 #pragma once
@@ -54,19 +54,19 @@
 namespace pcsg {
 
 struct PovOptions {
-    int width = 640, height = 480;     // the image size: sets the camera's aspect ratio
-    uint32_t maxUnionChildren = 32;    // larger unions are regrouped into a balanced nest
+    int width = 640, height = 480;   // the image size: sets the camera's aspect ratio
+    uint32_t maxUnionChildren = 32;  // larger unions are regrouped into a balanced nest
     // bounded_by boxes on unions too. Off: POV-Ray bounds a union of bounded objects
     // itself (and warns "CSG union unnecessarily bounded" for a top-level one).
     bool boundUnions = false;
-    std::string title;                 // the scene's name, for the header comment
+    std::string title;  // the scene's name, for the header comment
 };
 
 struct PovWriteStats {
-    uint64_t objects = 0;    // primitives written
-    uint64_t skipped = 0;    // degenerate triangles left out
-    uint64_t groups = 0;     // unions added by regrouping big unions
-    uint64_t bytes = 0;      // text written
+    uint64_t objects = 0;  // primitives written
+    uint64_t skipped = 0;  // degenerate triangles left out
+    uint64_t groups = 0;   // unions added by regrouping big unions
+    uint64_t bytes = 0;    // text written
 };
 
 // Writes the whole scene (settings, camera, lights, background, materials, the tree) to

@@ -1,9 +1,10 @@
 // Tests of the POV-Ray writer: the text for each primitive, the structure (materials,
 // bounds, regrouped unions), and POV-Ray itself: every primitive's silhouette as POV-Ray
-// renders it must match the solid of LANGUAGE.md section 5 seen through the camera of
+// renders it must match the solid of docs/language.md section 5 seen through the camera of
 // section 7, computed here independently by marching the same rays.
 #include "pov_writer.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,8 +12,6 @@
 #include <fstream>
 #include <functional>
 #include <numbers>
-
-#include <fmt/format.h>
 #include <regex>
 #include <sstream>
 
@@ -35,7 +34,8 @@ std::string exportText(const Graph& g, const PovOptions& opt = {}) {
 
 size_t occurrences(const std::string& text, const std::string& what) {
     size_t n = 0;
-    for (size_t pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + 1)) ++n;
+    for (size_t pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + 1))
+        ++n;
     return n;
 }
 
@@ -49,7 +49,9 @@ Graph single(P kind, NodeId (*wrap)(Graph&, NodeId), std::vector<double> values 
 NodeId moveScale(Graph& g, NodeId n) {
     return transform(g, TransformOp::Move, {1, 2, 3}, transform(g, TransformOp::UScale, {2}, n));
 }
-NodeId rotZ90(Graph& g, NodeId n) { return transform(g, TransformOp::RotZ, {90}, n); }
+NodeId rotZ90(Graph& g, NodeId n) {
+    return transform(g, TransformOp::RotZ, {90}, n);
+}
 
 TEST(PovWriter, HeaderHasVersionSettingsCameraLightsBackground) {
     Graph g = single(P::Sphere, moveScale);
@@ -89,7 +91,8 @@ TEST(PovWriter, EachMaterialIsDeclaredOnceAsATexture) {
     g.materials.push_back(bark);
     std::vector<NodeId> parts;
     for (int i = 0; i < 5; ++i)
-        parts.push_back(paint(g, 1, transform(g, TransformOp::Move, {double(i), 0, 0}, primitive(g, P::Sphere))));
+        parts.push_back(paint(
+            g, 1, transform(g, TransformOp::Move, {double(i), 0, 0}, primitive(g, P::Sphere))));
     parts.push_back(primitive(g, P::Cube));
     g.axiom = g.addNode(NodeKind::Union, kNone, parts);
     const std::string s = exportText(g);
@@ -109,37 +112,48 @@ TEST(PovWriter, EachMaterialIsDeclaredOnceAsATexture) {
 TEST(PovWriter, PrimitivesInPovRaysOwnFormWithTheTransposedMatrix) {
     // move(1,2,3) uscale(2): L = 2I, t = (1,2,3).
     const std::string m = " matrix<2,0,0,0,2,0,0,0,2,1,2,3>}";
-    EXPECT_NE(exportText(single(P::Sphere, moveScale)).find("sphere{<0,0,0>,1 texture{M0}" + m), std::string::npos);
-    EXPECT_NE(exportText(single(P::Cube, moveScale)).find("box{<-1,-1,-1>,<1,1,1> texture{M0}" + m), std::string::npos);
-    EXPECT_NE(exportText(single(P::Cylinder, moveScale)).find("cylinder{<0,0,0>,<0,0,1>,1 texture{M0}" + m),
+    EXPECT_NE(exportText(single(P::Sphere, moveScale)).find("sphere{<0,0,0>,1 texture{M0}" + m),
               std::string::npos);
-    EXPECT_NE(exportText(single(P::Cone, moveScale)).find("cone{<0,0,0>,1,<0,0,1>,0 texture{M0}" + m),
+    EXPECT_NE(exportText(single(P::Cube, moveScale)).find("box{<-1,-1,-1>,<1,1,1> texture{M0}" + m),
               std::string::npos);
-    EXPECT_NE(exportText(single(P::Plane, moveScale)).find("plane{<0,0,1>,0 texture{M0}" + m), std::string::npos);
+    EXPECT_NE(exportText(single(P::Cylinder, moveScale))
+                  .find("cylinder{<0,0,0>,<0,0,1>,1 texture{M0}" + m),
+              std::string::npos);
+    EXPECT_NE(
+        exportText(single(P::Cone, moveScale)).find("cone{<0,0,0>,1,<0,0,1>,0 texture{M0}" + m),
+        std::string::npos);
+    EXPECT_NE(exportText(single(P::Plane, moveScale)).find("plane{<0,0,1>,0 texture{M0}" + m),
+              std::string::npos);
     const std::string tetra = exportText(single(P::Tetrahedron, moveScale));
     EXPECT_NE(tetra.find("object{PcsgTetrahedron texture{M0}" + m), std::string::npos);
     EXPECT_EQ(occurrences(tetra, "#declare PcsgTetrahedron = intersection"), 1u);
     EXPECT_EQ(occurrences(tetra, "  plane { "), 4u);
     // rotz(90) takes x to y: L = [[0,-1,0],[1,0,0],[0,0,1]]; POV-Ray's rows are L's columns.
-    EXPECT_NE(exportText(single(P::Sphere, rotZ90)).find("matrix<0,1,0,-1,0,0,0,0,1,0,0,0>"), std::string::npos);
+    EXPECT_NE(exportText(single(P::Sphere, rotZ90)).find("matrix<0,1,0,-1,0,0,0,0,1,0,0,0>"),
+              std::string::npos);
     // The torus about z: POV-Ray's lies about y, so the matrix is L times (y -> z).
     const std::string torus = exportText(single(P::Torus, moveScale, {1.5, 0.25}));
-    EXPECT_NE(torus.find("torus{1.5,0.25 texture{M0} matrix<2,0,0,0,0,2,0,-2,0,1,2,3>}"), std::string::npos) << torus;
+    EXPECT_NE(torus.find("torus{1.5,0.25 texture{M0} matrix<2,0,0,0,0,2,0,-2,0,1,2,3>}"),
+              std::string::npos)
+        << torus;
     // Triangles: the corners in world coordinates.
     const std::string tri = exportText(single(P::Tri1, moveScale));
     EXPECT_NE(tri.find("triangle{<1,2,3>,<3,2,3>,<1,4,3> texture{M0}}"), std::string::npos) << tri;
     const std::string tri2 = exportText(single(P::Tri2, moveScale));
-    EXPECT_NE(tri2.find("triangle{<1,2,3>,<-1,2,3>,<1,0,3> texture{M0}}"), std::string::npos) << tri2;
-    const std::string tri3 = exportText(single(P::Triangle, moveScale, {0, 0, 0, 1, 0, 0, 0, 0, 1}));
-    EXPECT_NE(tri3.find("triangle{<1,2,3>,<3,2,3>,<1,2,5> texture{M0}}"), std::string::npos) << tri3;
+    EXPECT_NE(tri2.find("triangle{<1,2,3>,<-1,2,3>,<1,0,3> texture{M0}}"), std::string::npos)
+        << tri2;
+    const std::string tri3 =
+        exportText(single(P::Triangle, moveScale, {0, 0, 0, 1, 0, 0, 0, 0, 1}));
+    EXPECT_NE(tri3.find("triangle{<1,2,3>,<3,2,3>,<1,2,5> texture{M0}}"), std::string::npos)
+        << tri3;
 }
 
 TEST(PovWriter, DegenerateTrianglesAndEmptyAreLeftOut) {
     Graph g;
     defaultScene(g);
     g.axiom = g.addNode(NodeKind::Union, kNone,
-                        {primitive(g, P::Triangle, {0, 0, 0, 1, 1, 1, 2, 2, 2}), primitive(g, P::Empty),
-                         primitive(g, P::Tri1)});
+                        {primitive(g, P::Triangle, {0, 0, 0, 1, 1, 1, 2, 2, 2}),
+                         primitive(g, P::Empty), primitive(g, P::Tri1)});
     const ExpandedTree t = expand(g);
     std::ostringstream os;
     const PovWriteStats st = writePov(g, t, os);
@@ -153,20 +167,25 @@ TEST(PovWriter, IntersectionsAndDifferencesAreBounded) {
     // (plane ∩ sphere) ∪ (cube \ sphere), moved.
     Graph g;
     defaultScene(g);
-    const NodeId a = g.addNode(NodeKind::Intersection, kNone, {primitive(g, P::Plane), primitive(g, P::Sphere)});
+    const NodeId a =
+        g.addNode(NodeKind::Intersection, kNone, {primitive(g, P::Plane), primitive(g, P::Sphere)});
     const NodeId b = g.addNode(NodeKind::Difference, kNone,
-                               {primitive(g, P::Cube), transform(g, TransformOp::Move, {0, 0, 1}, primitive(g, P::Sphere))});
-    g.axiom = transform(g, TransformOp::Move, {10, 0, 0},
-                        g.addNode(NodeKind::Union, kNone, {a, transform(g, TransformOp::Move, {0, 5, 0}, b)}));
+                               {primitive(g, P::Cube), transform(g, TransformOp::Move, {0, 0, 1},
+                                                                 primitive(g, P::Sphere))});
+    g.axiom = transform(
+        g, TransformOp::Move, {10, 0, 0},
+        g.addNode(NodeKind::Union, kNone, {a, transform(g, TransformOp::Move, {0, 5, 0}, b)}));
     const std::string s = exportText(g);
     EXPECT_EQ(occurrences(s, "intersection {"), 1u);
     EXPECT_EQ(occurrences(s, "difference {"), 1u);
     EXPECT_EQ(occurrences(s, "union {"), 1u);
     // Two boxes: the intersection's is the lower half of the sphere's, the difference's
     // the cube's. The union has none: POV-Ray bounds unions of bounded objects itself.
-    const std::regex box(R"(bounded_by\{box\{<([-0-9.e]+),([-0-9.e]+),([-0-9.e]+)>,<([-0-9.e]+),([-0-9.e]+),([-0-9.e]+)>\}\})");
+    const std::regex box(
+        R"(bounded_by\{box\{<([-0-9.e]+),([-0-9.e]+),([-0-9.e]+)>,<([-0-9.e]+),([-0-9.e]+),([-0-9.e]+)>\}\})");
     std::vector<std::array<double, 6>> boxes;
-    for (auto it = std::sregex_iterator(s.begin(), s.end(), box); it != std::sregex_iterator(); ++it) {
+    for (auto it = std::sregex_iterator(s.begin(), s.end(), box); it != std::sregex_iterator();
+         ++it) {
         std::array<double, 6> v{};
         for (int i = 0; i < 6; ++i) v[i] = std::stod((*it)[i + 1]);
         boxes.push_back(v);
@@ -183,7 +202,8 @@ TEST(PovWriter, BigUnionsAreRegroupedIntoABalancedNest) {
     defaultScene(g);
     std::vector<NodeId> parts;
     for (int i = 0; i < 1000; ++i)
-        parts.push_back(transform(g, TransformOp::Move, {double(i) * 3, 0, 0}, primitive(g, P::Sphere)));
+        parts.push_back(
+            transform(g, TransformOp::Move, {double(i) * 3, 0, 0}, primitive(g, P::Sphere)));
     g.axiom = g.addNode(NodeKind::Union, kNone, parts);
     const ExpandedTree t = expand(g);
     std::ostringstream os;
@@ -226,7 +246,8 @@ TEST(PovWriter, BigUnionsAreRegroupedIntoABalancedNest) {
     // what random grouping would give (about 3000 per union).
     const std::regex box(R"(bounded_by\{box\{<([-0-9.e]+),[^>]*>,<([-0-9.e]+),)");
     double widths = 0;
-    for (auto it = std::sregex_iterator(s.begin(), s.end(), box); it != std::sregex_iterator(); ++it)
+    for (auto it = std::sregex_iterator(s.begin(), s.end(), box); it != std::sregex_iterator();
+         ++it)
         widths += std::stod((*it)[2]) - std::stod((*it)[1]);
     EXPECT_LT(widths, 3000.0 * 4);
 }
@@ -238,8 +259,9 @@ TEST(PovWriter, LongUnionChainsAreFlattenedBeforePovRaysBraceLimit) {
     defaultScene(g);
     NodeId n = primitive(g, P::Cube);
     for (int i = 0; i < 30000; ++i)
-        n = g.addNode(NodeKind::Union, kNone,
-                      {n, transform(g, TransformOp::Move, {0.001 * i, 0, 0}, primitive(g, P::Sphere))});
+        n = g.addNode(
+            NodeKind::Union, kNone,
+            {n, transform(g, TransformOp::Move, {0.001 * i, 0, 0}, primitive(g, P::Sphere))});
     g.axiom = n;
     const std::string s = exportText(g);
     int depth = 0, maxDepth = 0;
@@ -279,15 +301,19 @@ TEST(PovWriter, StreamsWithoutHoldingTheText) {
 }
 
 // ---------------------------------------------------------------------------------------
-// POV-Ray renders what LANGUAGE.md describes.
+// POV-Ray renders what docs/language.md describes.
 
-// The solid of a primitive in its own coordinates (LANGUAGE.md section 5).
+// The solid of a primitive in its own coordinates (docs/language.md section 5).
 bool insidePrimitive(P kind, const Vec3& p, const std::vector<double>& a) {
     switch (kind) {
-        case P::Sphere: return dot(p, p) <= 1;
-        case P::Cube: return std::fabs(p.x) <= 1 && std::fabs(p.y) <= 1 && std::fabs(p.z) <= 1;
-        case P::Cylinder: return p.x * p.x + p.y * p.y <= 1 && p.z >= 0 && p.z <= 1;
-        case P::Cone: return p.z >= 0 && p.z <= 1 && std::sqrt(p.x * p.x + p.y * p.y) <= 1 - p.z;
+        case P::Sphere:
+            return dot(p, p) <= 1;
+        case P::Cube:
+            return std::fabs(p.x) <= 1 && std::fabs(p.y) <= 1 && std::fabs(p.z) <= 1;
+        case P::Cylinder:
+            return p.x * p.x + p.y * p.y <= 1 && p.z >= 0 && p.z <= 1;
+        case P::Cone:
+            return p.z >= 0 && p.z <= 1 && std::sqrt(p.x * p.x + p.y * p.y) <= 1 - p.z;
         case P::Tetrahedron:
             for (const Vec3 v : {Vec3{1, 1, 1}, Vec3{-1, -1, 1}, Vec3{1, -1, -1}, Vec3{-1, 1, -1}})
                 if (-dot(v, p) > 1) return false;
@@ -296,8 +322,10 @@ bool insidePrimitive(P kind, const Vec3& p, const std::vector<double>& a) {
             const double q = std::sqrt(p.x * p.x + p.y * p.y) - a[0];
             return q * q + p.z * p.z <= a[1] * a[1];
         }
-        case P::Plane: return p.z <= 0;
-        default: return false;
+        case P::Plane:
+            return p.z <= 0;
+        default:
+            return false;
     }
 }
 
@@ -320,9 +348,9 @@ struct Pinhole {
 
 struct SilhouetteCase {
     std::string name;
-    std::function<NodeId(Graph&)> build;               // the scene's axiom
-    std::function<bool(const Vec3&)> inside;           // its solid, for marching
-    std::function<bool(const Vec3&, const Vec3&)> hit; // or a direct ray test (surfaces)
+    std::function<NodeId(Graph&)> build;                // the scene's axiom
+    std::function<bool(const Vec3&)> inside;            // its solid, for marching
+    std::function<bool(const Vec3&, const Vec3&)> hit;  // or a direct ray test (surfaces)
 };
 
 std::function<bool(const Vec3&)> solid(P kind, Affine toWorld, std::vector<double> args = {}) {
@@ -342,10 +370,13 @@ bool rayTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, con
     return u >= 0 && v >= 0 && u + v <= 1 && t > 0;
 }
 
-Affine mat(TransformOp op, std::vector<double> a) { return makeTransform(op, a.data()); }
+Affine mat(TransformOp op, std::vector<double> a) {
+    return makeTransform(op, a.data());
+}
 
 TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
-    if (!povtest::povrayInstalled()) GTEST_SKIP() << "povray is not installed (apt-get install povray)";
+    if (!povtest::povrayInstalled())
+        GTEST_SKIP() << "povray is not installed (apt-get install povray)";
     const int W = 80, H = 60;
     Camera cam;
     cam.location = {3, -6, 2.5};
@@ -358,8 +389,8 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
     // changes the silhouette.
     const Affine tilt = mat(TransformOp::RotY, {40}) * mat(TransformOp::Scale, {1.2, 0.8, 1.6});
     const Affine spin = mat(TransformOp::RotZ, {25}) * mat(TransformOp::RotX, {60});
-    const Affine shear = mat(TransformOp::Move, {0.2, 0, -0.3}) * mat(TransformOp::ZShear, {0.5, 0.2}) *
-                         mat(TransformOp::RotZ, {30});
+    const Affine shear = mat(TransformOp::Move, {0.2, 0, -0.3}) *
+                         mat(TransformOp::ZShear, {0.5, 0.2}) * mat(TransformOp::RotZ, {30});
     auto node = [](Graph& g, const Affine& m, NodeId child) {
         std::vector<double> a(12);
         for (int i = 0; i < 3; ++i)
@@ -370,13 +401,23 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
     std::vector<SilhouetteCase> cases;
     for (P k : {P::Sphere, P::Cube, P::Cylinder, P::Cone, P::Tetrahedron}) {
         for (const Affine* m : {&tilt, &spin, &shear}) {
-            cases.push_back({fmt::format("primitive{}_{}", int(k), m == &tilt ? "tilt" : m == &spin ? "spin" : "shear"),
-                             [=](Graph& g) { return node(g, *m, primitive(g, k)); }, solid(k, *m), nullptr});
+            cases.push_back({fmt::format("primitive{}_{}", int(k),
+                                         m == &tilt   ? "tilt"
+                                         : m == &spin ? "spin"
+                                                      : "shear"),
+                             [=](Graph& g) { return node(g, *m, primitive(g, k)); }, solid(k, *m),
+                             nullptr});
         }
     }
-    cases.push_back({"torus", [&](Graph& g) { return node(g, spin, primitive(g, P::Torus, {1.2, 0.35})); },
+    cases.push_back({"torus",
+                     [&](Graph& g) {
+                         return node(g, spin, primitive(g, P::Torus, {1.2, 0.35}));
+                     },
                      solid(P::Torus, spin, {1.2, 0.35}), nullptr});
-    cases.push_back({"torus_tilt", [&](Graph& g) { return node(g, tilt, primitive(g, P::Torus, {1, 0.5})); },
+    cases.push_back({"torus_tilt",
+                     [&](Graph& g) {
+                         return node(g, tilt, primitive(g, P::Torus, {1, 0.5}));
+                     },
                      solid(P::Torus, tilt, {1, 0.5}), nullptr});
     {
         // plane ∩ sphere, tilted: the half of the sphere on the side z <= 0 of the plane.
@@ -384,24 +425,28 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
         const auto inPlane = solid(P::Plane, pl), inSphere = solid(P::Sphere, Affine{});
         cases.push_back({"plane_cap",
                          [=](Graph& g) {
-                             return g.addNode(NodeKind::Intersection, kNone,
-                                              {node(g, pl, primitive(g, P::Plane)), primitive(g, P::Sphere)});
+                             return g.addNode(
+                                 NodeKind::Intersection, kNone,
+                                 {node(g, pl, primitive(g, P::Plane)), primitive(g, P::Sphere)});
                          },
                          [=](const Vec3& p) { return inPlane(p) && inSphere(p); }, nullptr});
     }
     {
         // cube \ sphere \ cylinder: a bite out of a corner and a hole.
         const Affine s = mat(TransformOp::Move, {1, -1, 1}) * mat(TransformOp::UScale, {0.9});
-        const Affine c = mat(TransformOp::Move, {0, 0, -2}) * mat(TransformOp::Scale, {0.4, 0.4, 4});
-        const auto inCube = solid(P::Cube, spin), inS = solid(P::Sphere, spin * s), inC = solid(P::Cylinder, spin * c);
-        cases.push_back({"difference",
-                         [=](Graph& g) {
-                             return node(g, spin,
-                                         g.addNode(NodeKind::Difference, kNone,
-                                                   {primitive(g, P::Cube), node(g, s, primitive(g, P::Sphere)),
-                                                    node(g, c, primitive(g, P::Cylinder))}));
-                         },
-                         [=](const Vec3& p) { return inCube(p) && !inS(p) && !inC(p); }, nullptr});
+        const Affine c =
+            mat(TransformOp::Move, {0, 0, -2}) * mat(TransformOp::Scale, {0.4, 0.4, 4});
+        const auto inCube = solid(P::Cube, spin), inS = solid(P::Sphere, spin * s),
+                   inC = solid(P::Cylinder, spin * c);
+        cases.push_back(
+            {"difference",
+             [=](Graph& g) {
+                 return node(g, spin,
+                             g.addNode(NodeKind::Difference, kNone,
+                                       {primitive(g, P::Cube), node(g, s, primitive(g, P::Sphere)),
+                                        node(g, c, primitive(g, P::Cylinder))}));
+             },
+             [=](const Vec3& p) { return inCube(p) && !inS(p) && !inC(p); }, nullptr});
     }
     {
         // Triangles: tri1, tri2 and a general one, tilted.
@@ -414,14 +459,16 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
                                                    {primitive(g, P::Tri1), primitive(g, P::Tri2),
                                                     primitive(g, P::Triangle, corners)}));
                          },
-                         nullptr, [=](const Vec3& o, const Vec3& d) {
+                         nullptr,
+                         [=](const Vec3& o, const Vec3& d) {
                              const Vec3 c[3][3] = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
                                                    {{0, 0, 0}, {-1, 0, 0}, {0, -1, 0}},
                                                    {{corners[0], corners[1], corners[2]},
                                                     {corners[3], corners[4], corners[5]},
                                                     {corners[6], corners[7], corners[8]}}};
                              for (const auto& t : c)
-                                 if (rayTriangle(o, d, m.point(t[0]), m.point(t[1]), m.point(t[2]))) return true;
+                                 if (rayTriangle(o, d, m.point(t[0]), m.point(t[1]), m.point(t[2])))
+                                     return true;
                              return false;
                          }});
     }
@@ -464,7 +511,8 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
                     const double b = dot(pin.eye, d), c = dot(pin.eye, pin.eye) - 3.5 * 3.5;
                     const double disc = b * b - c;
                     if (disc > 0)
-                        for (double s = -b - std::sqrt(disc), end = -b + std::sqrt(disc); s < end && !expected; s += 0.004)
+                        for (double s = -b - std::sqrt(disc), end = -b + std::sqrt(disc);
+                             s < end && !expected; s += 0.004)
                             expected = k.inside(pin.eye + d * s);
                 }
                 const bool got = r.at(i, j, 0) > 128;
@@ -478,13 +526,16 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
         EXPECT_GT(covered, W * H / 30) << k.name << ": the object is too small to test anything";
         // Marching can step over a thin chord near a corner (a pixel only POV-Ray covers);
         // it cannot invent coverage, so pixels only expected are held tighter.
-        EXPECT_LE(onlyPov, 10) << k.name << " (P: only POV-Ray covers, e: only expected)\n" << picture;
-        EXPECT_LE(onlyExpected, 3) << k.name << " (P: only POV-Ray covers, e: only expected)\n" << picture;
+        EXPECT_LE(onlyPov, 10) << k.name << " (P: only POV-Ray covers, e: only expected)\n"
+                               << picture;
+        EXPECT_LE(onlyExpected, 3) << k.name << " (P: only POV-Ray covers, e: only expected)\n"
+                                   << picture;
     }
 }
 
 TEST(PovRay, ParsesAndRendersEveryPrimitiveWithoutWarnings) {
-    if (!povtest::povrayInstalled()) GTEST_SKIP() << "povray is not installed (apt-get install povray)";
+    if (!povtest::povrayInstalled())
+        GTEST_SKIP() << "povray is not installed (apt-get install povray)";
     // Sierpinski order 3 beside one of each primitive, with materials and several lights.
     Graph g = sierpinski(3);
     g.materials.push_back(Material{"red", {0.8, 0.1, 0.1}, 0.1, 0.7, 0.4, 30, 0});
@@ -494,7 +545,9 @@ TEST(PovRay, ParsesAndRendersEveryPrimitiveWithoutWarnings) {
     std::vector<NodeId> parts = {g.axiom};
     int x = 0;
     for (P k : {P::Sphere, P::Cube, P::Cylinder, P::Cone, P::Tetrahedron, P::Tri1, P::Tri2}) {
-        parts.push_back(paint(g, 1 + (x % 2), transform(g, TransformOp::Move, {3.0 + 2.5 * x, 0, 0}, primitive(g, k))));
+        parts.push_back(
+            paint(g, 1 + (x % 2),
+                  transform(g, TransformOp::Move, {3.0 + 2.5 * x, 0, 0}, primitive(g, k))));
         ++x;
     }
     parts.push_back(transform(g, TransformOp::Move, {-3, 0, 0}, primitive(g, P::Torus, {1, 0.3})));
@@ -514,13 +567,15 @@ TEST(PovRay, ParsesAndRendersEveryPrimitiveWithoutWarnings) {
     // The background shows, and so does something else.
     int background = 0;
     for (int j = 0; j < 48; ++j)
-        for (int i = 0; i < 64; ++i) background += r.at(i, j, 0) == r.at(0, 0, 0) && r.at(i, j, 2) == r.at(0, 0, 2);
+        for (int i = 0; i < 64; ++i)
+            background += r.at(i, j, 0) == r.at(0, 0, 0) && r.at(i, j, 2) == r.at(0, 0, 2);
     EXPECT_GT(background, 100);
     EXPECT_LT(background, 64 * 48 - 100);
 }
 
 TEST(PovRay, AnEmptySceneRendersTheBackground) {
-    if (!povtest::povrayInstalled()) GTEST_SKIP() << "povray is not installed (apt-get install povray)";
+    if (!povtest::povrayInstalled())
+        GTEST_SKIP() << "povray is not installed (apt-get install povray)";
     Graph g;
     defaultScene(g);
     g.scene.background = {0, 1, 0};

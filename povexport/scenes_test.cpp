@@ -3,6 +3,7 @@
 // POV-Ray parsing and rendering every exported scene without a warning. Scenes whose
 // trees are large are rendered at a lower order (their order assignment is rewritten
 // in the source text), so the suite stays fast.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,8 +11,6 @@
 #include <fstream>
 #include <map>
 #include <sstream>
-
-#include <fmt/format.h>
 
 #include "compiler.h"
 #include "expander.h"
@@ -68,14 +67,17 @@ std::vector<fs::path> sceneFiles() {
     return files;
 }
 
-uint64_t pow4(int n) { return uint64_t{1} << (2 * n); }
+uint64_t pow4(int n) {
+    return uint64_t{1} << (2 * n);
+}
 
 TEST(Scenes, SierpinskiOfOrderNHasFourToTheNTetrahedra) {
     const fs::path file = fs::path(PCSG_SCENES_DIR) / "sierpinski.pcsg";
     if (!fs::exists(file)) GTEST_SKIP() << file << " is missing";
     const std::string text = readFile(file);
     for (int n = 0; n <= 5; ++n) {
-        const Graph g = compileText("sierpinski", replaceOnce(text, "{c=6}", fmt::format("{{c={}}}", n)));
+        const Graph g =
+            compileText("sierpinski", replaceOnce(text, "{c=6}", fmt::format("{{c={}}}", n)));
         const ExpandedTree t = expand(g);
         EXPECT_EQ(t.primitives.size(), pow4(n)) << "order " << n;
         for (const TreePrimitive& p : t.primitives) EXPECT_EQ(p.kind, PrimitiveKind::Tetrahedron);
@@ -86,7 +88,9 @@ TEST(Scenes, SierpinskiOfOrderNHasFourToTheNTetrahedra) {
     if (fs::exists(pl)) {
         const std::string b = readFile(pl);
         EXPECT_EQ(countExpansion(compileText("sierpinski_pl", b)).primitives, pow4(6));
-        EXPECT_EQ(expand(compileText("sierpinski_pl", replaceOnce(b, "S(6)", "S(3)"))).primitives.size(), pow4(3));
+        EXPECT_EQ(
+            expand(compileText("sierpinski_pl", replaceOnce(b, "S(6)", "S(3)"))).primitives.size(),
+            pow4(3));
     }
 }
 
@@ -98,18 +102,22 @@ TEST(Scenes, TerrainsHaveTwoTimesFourToTheNTriangles) {
         int n;
         uint64_t extra;
     };
-    for (const Case& c : {Case{"terrain", "cnt = 10;", 10, 0}, Case{"terrain_sea", "cnt = 9;", 9, 1},
-                          Case{"landsberg", "cnt = 8;", 8, 0}}) {
+    for (const Case& c :
+         {Case{"terrain", "cnt = 10;", 10, 0}, Case{"terrain_sea", "cnt = 9;", 9, 1},
+          Case{"landsberg", "cnt = 8;", 8, 0}}) {
         const fs::path file = fs::path(PCSG_SCENES_DIR) / (std::string(c.scene) + ".pcsg");
         if (!fs::exists(file)) continue;
         const std::string text = readFile(file);
         // The file's own order is counted only where that is quick (terrain's 2^21
         // triangles take seconds: nothing repeats to memoise).
         if (c.n <= 8) {
-            EXPECT_EQ(countExpansion(compileText(c.scene, text)).primitives, 2 * pow4(c.n) + c.extra) << c.scene;
+            EXPECT_EQ(countExpansion(compileText(c.scene, text)).primitives,
+                      2 * pow4(c.n) + c.extra)
+                << c.scene;
         }
         for (int n = 1; n <= 3; ++n) {
-            const ExpandedTree t = expand(compileText(c.scene, replaceOnce(text, c.order, fmt::format("cnt = {};", n))));
+            const ExpandedTree t = expand(
+                compileText(c.scene, replaceOnce(text, c.order, fmt::format("cnt = {};", n))));
             EXPECT_EQ(t.primitives.size(), 2 * pow4(n) + c.extra) << c.scene << " order " << n;
         }
     }
@@ -119,27 +127,34 @@ TEST(Scenes, EveryStochasticSceneExpandsIdenticallyTwice) {
     int stochastic = 0;
     for (const fs::path& file : sceneFiles()) {
         const std::string text = readFile(file);
-        if (text.find("rand(") == std::string::npos && text.find("choose(") == std::string::npos) continue;
+        if (text.find("rand(") == std::string::npos && text.find("choose(") == std::string::npos)
+            continue;
         const std::string name = file.stem().string();
-        const std::string src = kReduced.count(name) ? replaceOnce(text, kReduced.at(name).from, kReduced.at(name).to) : text;
+        const std::string src =
+            kReduced.count(name) ? replaceOnce(text, kReduced.at(name).from, kReduced.at(name).to)
+                                 : text;
         const Graph g = compileText(name, src);
         const ExpandedTree a = expand(g), b = expand(compileText(name, src));
         ASSERT_EQ(a.primitives.size(), b.primitives.size()) << name;
         EXPECT_GT(a.primitives.size(), 0u) << name;
         EXPECT_EQ(a.children, b.children) << name;
         for (size_t i = 0; i < a.primitives.size(); ++i) {
-            ASSERT_EQ(a.primitives[i].toWorld, b.primitives[i].toWorld) << name << " primitive " << i;
-            ASSERT_EQ(a.primitives[i].material, b.primitives[i].material) << name << " primitive " << i;
+            ASSERT_EQ(a.primitives[i].toWorld, b.primitives[i].toWorld)
+                << name << " primitive " << i;
+            ASSERT_EQ(a.primitives[i].material, b.primitives[i].material)
+                << name << " primitive " << i;
         }
         EXPECT_EQ(a.args, b.args) << name;
         EXPECT_EQ(countExpansion(g).nodes, a.nodes.size()) << name;
         ++stochastic;
     }
-    if (stochastic == 0) GTEST_SKIP() << "no scene in " << PCSG_SCENES_DIR << " uses rand() or choose()";
+    if (stochastic == 0)
+        GTEST_SKIP() << "no scene in " << PCSG_SCENES_DIR << " uses rand() or choose()";
 }
 
 TEST(Scenes, PovRayRendersEveryExportedSceneWithoutWarnings) {
-    if (!povtest::povrayInstalled()) GTEST_SKIP() << "povray is not installed (apt-get install povray)";
+    if (!povtest::povrayInstalled())
+        GTEST_SKIP() << "povray is not installed (apt-get install povray)";
     const std::vector<fs::path> files = sceneFiles();
     if (files.empty()) GTEST_SKIP() << "no scenes in " << PCSG_SCENES_DIR;
     constexpr uint64_t kMaxNodes = 400'000;
@@ -148,7 +163,8 @@ TEST(Scenes, PovRayRendersEveryExportedSceneWithoutWarnings) {
     for (const fs::path& file : files) {
         const std::string name = file.stem().string();
         std::string text = readFile(file);
-        if (kReduced.count(name)) text = replaceOnce(text, kReduced.at(name).from, kReduced.at(name).to);
+        if (kReduced.count(name))
+            text = replaceOnce(text, kReduced.at(name).from, kReduced.at(name).to);
         const Graph g = compileText(name, text);
         if (g.axiom == kNone) continue;  // reported by compileText
         const ExpansionCount count = countExpansion(g);

@@ -29,16 +29,21 @@ inline ExprId addCode(Graph& g, std::vector<Instr> code, uint32_t maxStack,
     return static_cast<ExprId>(g.exprs.size() - 1);
 }
 
-inline Instr cst(double v) { return Instr{Op::Const, 0, 0, v}; }
-inline Instr load(Slot s) { return Instr{Op::Load, 0, s, 0}; }
-inline Instr op(Op o, uint32_t a = 0, uint8_t argc = 0) { return Instr{o, argc, a, 0}; }
+inline Instr cst(double v) {
+    return Instr{Op::Const, 0, 0, v};
+}
+inline Instr load(Slot s) {
+    return Instr{Op::Load, 0, s, 0};
+}
+inline Instr op(Op o, uint32_t a = 0, uint8_t argc = 0) {
+    return Instr{o, argc, a, 0};
+}
 
 // if(slot > 0, a, b)
 inline ExprId ifPositive(Graph& g, Slot s, double a, double b) {
-    return addCode(g,
-                   {load(s), cst(0), op(Op::Gt), op(Op::JumpIfZero, 6), cst(a), op(Op::Jump, 7),
-                    cst(b)},
-                   2, "if(c > 0, a, b)");
+    return addCode(
+        g, {load(s), cst(0), op(Op::Gt), op(Op::JumpIfZero, 6), cst(a), op(Op::Jump, 7), cst(b)}, 2,
+        "if(c > 0, a, b)");
 }
 
 // slot + delta
@@ -132,7 +137,8 @@ inline Graph sierpinski(int order, PrimitiveKind leaf = PrimitiveKind::Tetrahedr
     const Slot c = g.slot("c");
     const NodeId s = module(g, "S", ifPositive(g, c, 2, 1), 2);
     setRule(g, s, 0, primitive(g, leaf));
-    const double corners[4][3] = {{0.5, 0.5, 0.5}, {-0.5, -0.5, 0.5}, {0.5, -0.5, -0.5}, {-0.5, 0.5, -0.5}};
+    const double corners[4][3] = {
+        {0.5, 0.5, 0.5}, {-0.5, -0.5, 0.5}, {0.5, -0.5, -0.5}, {-0.5, 0.5, -0.5}};
     std::vector<NodeId> parts;
     for (const auto& k : corners)
         parts.push_back(transform(g, TransformOp::Move, {k[0], k[1], k[2]},
@@ -144,7 +150,8 @@ inline Graph sierpinski(int order, PrimitiveKind leaf = PrimitiveKind::Tetrahedr
 }
 
 // A stochastic branching system: {d = depth} B; B if(d > 0, choose(0.5, 0.5), 1);
-// 1: B -> move(rand(), 0, 0) sphere; 2: B -> {d = d-1} (move(0,0,1) uscale(.6) B ∪ rotz(90) B ∪ cube).
+// 1: B -> move(rand(), 0, 0) sphere; 2: B -> {d = d-1} (move(0,0,1) uscale(.6) B ∪ rotz(90) B ∪
+// cube).
 inline Graph stochastic(int depth) {
     Graph g;
     defaultScene(g);
@@ -159,9 +166,11 @@ inline Graph stochastic(int depth) {
     const NodeId leaf = transformOf(g, TransformOp::Move, {rnd, g.addConstant(0), g.addConstant(0)},
                                     primitive(g, PrimitiveKind::Sphere));
     setRule(g, b, 0, leaf);
-    const NodeId up = transform(g, TransformOp::Move, {0, 0, 1}, transform(g, TransformOp::UScale, {0.6}, b));
+    const NodeId up =
+        transform(g, TransformOp::Move, {0, 0, 1}, transform(g, TransformOp::UScale, {0.6}, b));
     const NodeId turned = transform(g, TransformOp::RotZ, {90}, b);
-    const NodeId u = g.addNode(NodeKind::Union, kNone, {up, turned, primitive(g, PrimitiveKind::Cube)});
+    const NodeId u =
+        g.addNode(NodeKind::Union, kNone, {up, turned, primitive(g, PrimitiveKind::Cube)});
     setRule(g, b, 1, calc(g, {{d, plusConst(g, d, -1)}}, u));
     g.axiom = calc(g, {{d, g.addConstant(depth)}}, b);
     return g;

@@ -23,7 +23,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path corpusDir() { return fs::path(PCSG_SOURCE_DIR) / "tests" / "diagnostics"; }
+fs::path corpusDir() {
+    return fs::path(PCSG_SOURCE_DIR) / "tests" / "diagnostics";
+}
 
 std::vector<std::string> corpusFiles() {
     std::vector<std::string> files;
@@ -90,7 +92,8 @@ TEST_P(Corpus, GivesExactlyTheExpectedErrors) {
     size_t carets = 0;
     std::istringstream lines(printed);
     for (std::string l; std::getline(lines, l);)
-        if (!l.empty() && l.back() == '^' && l.find_first_not_of(" \t^") == std::string::npos) ++carets;
+        if (!l.empty() && l.back() == '^' && l.find_first_not_of(" \t^") == std::string::npos)
+            ++carets;
     EXPECT_EQ(carets, diags.errors().size()) << printed;
 }
 
@@ -104,7 +107,7 @@ std::string testName(const testing::TestParamInfo<std::string>& info) {
 INSTANTIATE_TEST_SUITE_P(Diagnostics, Corpus, testing::ValuesIn(corpusFiles()), testName);
 
 TEST(CorpusSize, CoversTheLanguage) {
-    // Every kind of bad input in LANGUAGE.md section 8 and every compile-time error of
+    // Every kind of bad input in docs/language.md section 8 and every compile-time error of
     // sections 1-7 has a file; the corpus only grows.
     EXPECT_GE(corpusFiles().size(), 30u);
 }

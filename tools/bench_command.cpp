@@ -2,6 +2,7 @@
 // one run on one machine, at the same size and sampling, and compare time and memory.
 // Ratios measured side by side are what the targets of docs/benchmarks.md are about;
 // absolute times on a shared machine are not.
+#include <fmt/format.h>
 #include <sys/utsname.h>
 
 #include <algorithm>
@@ -10,10 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <thread>
-
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "commands.h"
 #include "renders.h"
@@ -52,9 +51,9 @@ struct BenchRow {
 // paper's plant and terrain.
 std::vector<std::string> defaultScenes() {
     const std::string root = PCSG_SOURCE_DIR;
-    return {root + "/scenes/sierpinski.pcsg",        root + "/tools/bench/sierpinski_8.pcsg",
+    return {root + "/scenes/sierpinski.pcsg",         root + "/tools/bench/sierpinski_8.pcsg",
             root + "/tools/bench/sierpinski_10.pcsg", root + "/tools/bench/sierpinski_12.pcsg",
-            root + "/scenes/sympodial_tree.pcsg",    root + "/scenes/terrain.pcsg"};
+            root + "/scenes/sympodial_tree.pcsg",     root + "/scenes/terrain.pcsg"};
 }
 
 std::string machine() {
@@ -84,10 +83,11 @@ BenchRow benchScene(const std::string& scene, const BenchOptions& o, const fs::p
     std::vector<std::string> threads;
     if (o.threads > 0) threads = {"--threads", std::to_string(o.threads)};
     std::vector<std::string> nativeArgs = threads;
-    if (o.adaptive > 0) nativeArgs.insert(nativeArgs.end(), {"--adaptive", fmt::format("{}", o.adaptive)});
+    if (o.adaptive > 0)
+        nativeArgs.insert(nativeArgs.end(), {"--adaptive", fmt::format("{}", o.adaptive)});
 
-    const RenderRun native = renderNative(scene, (work / (row.scene + "_native.png")).string(), o.width,
-                                          o.height, nativeArgs);
+    const RenderRun native = renderNative(scene, (work / (row.scene + "_native.png")).string(),
+                                          o.width, o.height, nativeArgs);
     row.nativeOk = native.ok;
     if (!native.ok) {
         row.note = native.error;
@@ -114,8 +114,8 @@ BenchRow benchScene(const std::string& scene, const BenchOptions& o, const fs::p
     }
     std::vector<std::string> povArgs = {o.adaptive > 0 ? fmt::format("+A{}", o.adaptive) : "-A"};
     if (o.threads > 0) povArgs.push_back("+WT" + std::to_string(o.threads));
-    const RenderRun povray = renderPovray(pov.string(), (work / (row.scene + "_povray.png")).string(),
-                                          o.width, o.height, povArgs);
+    const RenderRun povray = renderPovray(
+        pov.string(), (work / (row.scene + "_povray.png")).string(), o.width, o.height, povArgs);
     std::error_code ec;
     fs::remove(pov, ec);
     row.povOk = povray.ok;
@@ -166,11 +166,13 @@ std::string targetsOf(const std::vector<BenchRow>& rows) {
 }
 
 std::string tableOf(const std::vector<BenchRow>& rows, const BenchOptions& o) {
-    std::string t = fmt::format("Benchmark of {}, {}: {}x{}, {} (both renderers), measured side by side.\n\n",
-                                today(), machine(), o.width, o.height,
-                                o.adaptive > 0 ? fmt::format("adaptive anti-aliasing {}", o.adaptive)
-                                               : std::string("no anti-aliasing"));
-    t += "| scene | primitives | native time | POV-Ray time (parse) | POV-Ray / native | rays/s | native peak RSS | POV-Ray peak RSS | RSS ratio |\n";
+    std::string t =
+        fmt::format("Benchmark of {}, {}: {}x{}, {} (both renderers), measured side by side.\n\n",
+                    today(), machine(), o.width, o.height,
+                    o.adaptive > 0 ? fmt::format("adaptive anti-aliasing {}", o.adaptive)
+                                   : std::string("no anti-aliasing"));
+    t += "| scene | primitives | native time | POV-Ray time (parse) | POV-Ray / native | rays/s | "
+         "native peak RSS | POV-Ray peak RSS | RSS ratio |\n";
     t += "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const auto& r : rows) {
         const std::string prims = r.primitives ? fmt::format("{}", *r.primitives) : "-";
@@ -181,12 +183,14 @@ std::string tableOf(const std::vector<BenchRow>& rows, const BenchOptions& o) {
             if (r.povParseSeconds) pov += fmt::format(" ({:.2f} s)", *r.povParseSeconds);
             timeRatio = fmt::format("{:.2f}", r.povSeconds / std::max(r.nativeSeconds, 1e-9));
             povRss = humanBytes(r.povRss);
-            rssRatio = fmt::format("{:.1f}", double(r.povRss) / double(std::max<uint64_t>(r.nativeRss, 1)));
+            rssRatio = fmt::format("{:.1f}",
+                                   double(r.povRss) / double(std::max<uint64_t>(r.nativeRss, 1)));
         } else if (!r.note.empty()) {
             pov = r.note.substr(0, r.note.find('\n'));
         }
-        t += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.scene, prims, native, pov,
-                         timeRatio, r.raysPerSecond ? fmt::format("{:.0f}", *r.raysPerSecond) : "-",
+        t += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.scene, prims, native,
+                         pov, timeRatio,
+                         r.raysPerSecond ? fmt::format("{:.0f}", *r.raysPerSecond) : "-",
                          r.nativeOk ? humanBytes(r.nativeRss) : "-", povRss, rssRatio);
     }
     t += targetsOf(rows);
@@ -225,8 +229,10 @@ int runBench(BenchOptions o) {
     if (o.json) {
         nlohmann::json j = nlohmann::json::array();
         for (const auto& r : rows) {
-            nlohmann::json e = {{"scene", r.scene}, {"native_ok", r.nativeOk}, {"povray_ok", r.povOk}};
-            if (r.nativeOk) e["native_seconds"] = r.nativeSeconds, e["native_peak_rss_bytes"] = r.nativeRss;
+            nlohmann::json e = {
+                {"scene", r.scene}, {"native_ok", r.nativeOk}, {"povray_ok", r.povOk}};
+            if (r.nativeOk)
+                e["native_seconds"] = r.nativeSeconds, e["native_peak_rss_bytes"] = r.nativeRss;
             if (r.imageWriterRss) e["native_image_writer_peak_rss_bytes"] = *r.imageWriterRss;
             if (r.povOk) e["povray_seconds"] = r.povSeconds, e["povray_peak_rss_bytes"] = r.povRss;
             if (r.povParseSeconds) e["povray_parse_seconds"] = *r.povParseSeconds;
@@ -235,8 +241,9 @@ int runBench(BenchOptions o) {
             if (!r.note.empty()) e["note"] = r.note;
             j.push_back(e);
         }
-        std::cout << nlohmann::json{{"date", today()}, {"machine", machine()}, {"width", o.width},
-                                    {"height", o.height}, {"adaptive", o.adaptive}, {"scenes", j}}
+        std::cout << nlohmann::json{{"date", today()},        {"machine", machine()},
+                                    {"width", o.width},       {"height", o.height},
+                                    {"adaptive", o.adaptive}, {"scenes", j}}
                          .dump(2)
                   << "\n";
     } else {
@@ -271,9 +278,11 @@ void addBenchCommand(CLI::App& app, int& status) {
                     "Adaptive anti-aliasing threshold for both (POV-Ray's +A); 0 for none")
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "Threads for both renderers (default: all cores)");
-    cmd->add_option("--max-nodes", o->maxNodes, "Expansion budget for the exported tree")->capture_default_str();
+    cmd->add_option("--max-nodes", o->maxNodes, "Expansion budget for the exported tree")
+        ->capture_default_str();
     cmd->add_flag("--native-only", o->nativeOnly, "Render natively only (no POV-Ray)");
-    cmd->add_option("--markdown", o->markdown, "Append the table, with date and machine, to this file");
+    cmd->add_option("--markdown", o->markdown,
+                    "Append the table, with date and machine, to this file");
     cmd->add_flag("--json", o->json, "Print the results as JSON");
     cmd->callback([o, &status] { status = runBench(*o); });
 }

@@ -1,5 +1,6 @@
 // pcsg bench: the table it prints and appends, its JSON, and its verdicts on the targets.
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_test_util.h"

@@ -1,10 +1,10 @@
 // pcsg check FILE [--stats] [--json]: compile a scene, print its diagnostics, exit 0
 // when it compiles and 1 when it does not; with --stats the cyclic graph's figures:
 // nodes by kind, edges, modules, parameters, expressions and its size in bytes.
+#include <fmt/format.h>
+
 #include <iostream>
 #include <memory>
-
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -72,8 +72,8 @@ int runCheck(const CheckOptions& o) {
     }
     if (!o.stats) {
         std::cout << fmt::format("{}: ok ({} module{}, {} nodes, {} graph)\n", o.scene,
-                                 g.modules.size(), g.modules.size() == 1 ? "" : "s",
-                                 g.nodes.size(), humanBytes(*stats.graphBytes));
+                                 g.modules.size(), g.modules.size() == 1 ? "" : "s", g.nodes.size(),
+                                 humanBytes(*stats.graphBytes));
         return 0;
     }
     // Column widths count bytes, and ∪ ∩ are three bytes each: pad by display width.
@@ -99,7 +99,8 @@ int runCheck(const CheckOptions& o) {
 void addCheckCommand(CLI::App& app, int& status) {
     auto o = std::make_shared<CheckOptions>();
     auto* cmd = app.add_subcommand(
-        "check", "Compile a scene and print its errors: exit status 0 when it compiles, 1 when not");
+        "check",
+        "Compile a scene and print its errors: exit status 0 when it compiles, 1 when not");
     cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input)")->required();
     cmd->add_flag("--stats", o->stats,
                   "Print the cyclic graph's figures: nodes by kind, edges, modules, parameters, "

@@ -112,7 +112,8 @@ TEST(CheckCommand, FilesThatAreNotScenesGetACleanError) {
     EXPECT_EQ(empty.exitCode, 1);
     EXPECT_NE(empty.err.find("empty.pcsg:1:1: error: "), std::string::npos) << empty.err;
 
-    const ChildResult garbage = pcsg({"check", dir.write("garbage.pcsg", std::string("\x00\xff\xfe{{((\x01", 9))});
+    const ChildResult garbage =
+        pcsg({"check", dir.write("garbage.pcsg", std::string("\x00\xff\xfe{{((\x01", 9))});
     EXPECT_EQ(garbage.exitCode, 1);
     EXPECT_NE(garbage.err.find("garbage.pcsg:1:"), std::string::npos) << garbage.err;
 }

@@ -53,7 +53,7 @@ void setNonBlocking(int fd) {
 // cannot kill this process. SIGPIPE from write() goes to the writing thread, so other
 // threads (the render's) are not involved.
 class SigpipeBlock {
-public:
+  public:
     SigpipeBlock() {
         sigemptyset(&pipeSignal_);
         sigaddset(&pipeSignal_, SIGPIPE);
@@ -76,7 +76,7 @@ public:
 
     void raised() { raised_ = true; }
 
-private:
+  private:
     sigset_t pipeSignal_, oldMask_;
     bool pendingBefore_ = false, raised_ = false;
 };

@@ -17,10 +17,10 @@
 namespace pcsg::tools {
 
 struct ChildResult {
-    bool started = false;   // false: the program could not be run at all
-    int exitCode = -1;      // -1 when killed by a signal
+    bool started = false;  // false: the program could not be run at all
+    int exitCode = -1;     // -1 when killed by a signal
     int signal = 0;
-    double seconds = 0;     // wall time, from the start to the exit
+    double seconds = 0;  // wall time, from the start to the exit
     // The child's peak RSS as wait4 reports it (Linux): the largest of the child's own,
     // that of any descendant it waited for (a `pcsg render` that ran pcsg-image reports
     // the larger of the two; `pcsg render --json` prints its own as "peak_rss_bytes"),
@@ -28,7 +28,7 @@ struct ChildResult {
     // process's memory until its exec, and exec records that memory's peak as the
     // child's. So a small parent matters for honest figures.
     uint64_t peakRssBytes = 0;
-    std::string out, err;   // captured standard output and error
+    std::string out, err;  // captured standard output and error
     // With input: how many of its bytes the child took before it exited or closed its
     // standard input (all of them unless it stopped reading early).
     size_t inputWritten = 0;
@@ -51,7 +51,7 @@ ChildResult runChild(const std::vector<std::string>& argv, std::span<const std::
 // Every child is reaped: by wait(), by abandon(), or else by the destructor (which
 // abandons it). This process never gets a SIGPIPE from a child that is gone.
 class AsyncChild {
-public:
+  public:
     enum class Input { Pipe, DevNull };
 
     // Starts argv[0] (searched in PATH) with the arguments; started() says whether it ran.
@@ -84,7 +84,7 @@ public:
     // take as long as its start-up. Returns how it ended (the output left empty).
     ChildResult abandon();
 
-private:
+  private:
     void readOutput(int& fd, std::string& into);
     bool pump(bool writing, std::span<const std::byte> data, size_t& written);
     ChildResult reap(bool keepOutput);

@@ -18,7 +18,7 @@
 
 namespace pcsg::tools::testing {
 
-// The paper's figure 3a (with the parentheses LANGUAGE.md asks for) and figure 2.
+// The paper's figure 3a (with the parentheses docs/language.md asks for) and figure 2.
 inline const char* kSierpinskiA = R"(// figure 3a
 {c=6} S
 S if(c > 0, 2, 1)
@@ -40,7 +40,7 @@ p2: S(c) : c > 0 -> move(0.5,0.5,0.5) uscale(0.5) S(c-1) ∪
 
 // A temporary directory, removed with everything in it at the end of the test.
 class TempDir {
-public:
+  public:
     TempDir() {
         std::string tmpl =
             (std::filesystem::temp_directory_path() / "pcsg-cli-test-XXXXXX").string();
@@ -60,7 +60,7 @@ public:
     }
     const std::string& path() const { return path_; }
 
-private:
+  private:
     std::string path_;
 };
 

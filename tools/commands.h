@@ -9,11 +9,11 @@ namespace pcsg::tools {
 
 // Each function registers one or more subcommands. A subcommand's callback stores its
 // exit status in `status` (0 success, 1 failure of the input, 2 could not run).
-void addCheckCommand(CLI::App& app, int& status);   // check
-void addGraphCommand(CLI::App& app, int& status);   // graph
-void addRenderCommand(CLI::App& app, int& status);  // render
-void addExportCommands(CLI::App& app, int& status); // export-pov, stats
-void addVerifyCommand(CLI::App& app, int& status);  // verify
-void addBenchCommand(CLI::App& app, int& status);   // bench
+void addCheckCommand(CLI::App& app, int& status);    // check
+void addGraphCommand(CLI::App& app, int& status);    // graph
+void addRenderCommand(CLI::App& app, int& status);   // render
+void addExportCommands(CLI::App& app, int& status);  // export-pov, stats
+void addVerifyCommand(CLI::App& app, int& status);   // verify
+void addBenchCommand(CLI::App& app, int& status);    // bench
 
 }  // namespace pcsg::tools

@@ -8,16 +8,16 @@
 //
 // Exit status: 0 success, 1 the scene is at fault (compile error, run-time error, too
 // large for the node budget), 2 something could not run (the output is not writable).
+#include <fmt/format.h>
+
 #include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "eval.h"
@@ -69,8 +69,10 @@ int runExport(const ExportOptions& o) {
         std::cerr << fmt::format("pcsg export-pov: error: {}: {}\n", o.scene, e.what());
         return 1;
     } catch (const std::bad_alloc&) {
-        std::cerr << fmt::format("pcsg export-pov: error: {}: out of memory while expanding; "
-                                 "lower --max-nodes\n", o.scene);
+        std::cerr << fmt::format(
+            "pcsg export-pov: error: {}: out of memory while expanding; "
+            "lower --max-nodes\n",
+            o.scene);
         return 1;
     }
     const double expandSeconds = since(start);
@@ -120,7 +122,8 @@ int runExport(const ExportOptions& o) {
         fs::rename(temp, target, ec);
         if (ec) {
             fs::remove(temp, ec);
-            std::cerr << "pcsg export-pov: cannot write " << o.output << ": " << ec.message() << "\n";
+            std::cerr << "pcsg export-pov: cannot write " << o.output << ": " << ec.message()
+                      << "\n";
             return 2;
         }
     }
@@ -153,8 +156,9 @@ int runExport(const ExportOptions& o) {
                               o.output == "-" ? std::string("standard output") : o.output,
                               written.objects, humanBytes(written.bytes), *s.seconds);
         if (written.skipped)
-            report << fmt::format("  left out {} degenerate triangle{} (no area; POV-Ray rejects them)\n",
-                                  written.skipped, written.skipped == 1 ? "" : "s");
+            report << fmt::format(
+                "  left out {} degenerate triangle{} (no area; POV-Ray rejects them)\n",
+                written.skipped, written.skipped == 1 ? "" : "s");
     }
     return 0;
 }

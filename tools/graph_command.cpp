@@ -1,6 +1,7 @@
 // pcsg graph FILE [-o OUT]: the scene's cyclic CSG graph as Graphviz DOT (graph_dot.h),
 // on standard output, into OUT.dot/OUT.gv, or drawn by Graphviz's `dot` into
 // OUT.svg/OUT.png/OUT.pdf.
+#include <fmt/format.h>
 #include <stdlib.h>
 
 #include <cctype>
@@ -10,8 +11,6 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
-
-#include <fmt/format.h>
 
 #include "child_process.h"
 #include "commands.h"
@@ -37,8 +36,12 @@ std::string extensionOf(const std::string& path) {
     return ext;
 }
 
-bool isDotFile(const std::string& ext) { return ext == "dot" || ext == "gv"; }
-bool isDrawing(const std::string& ext) { return ext == "svg" || ext == "png" || ext == "pdf"; }
+bool isDotFile(const std::string& ext) {
+    return ext == "dot" || ext == "gv";
+}
+bool isDrawing(const std::string& ext) {
+    return ext == "svg" || ext == "png" || ext == "pdf";
+}
 
 // Writes `text` to `path`; false with a message on `std::cerr` when it cannot.
 bool writeFile(const std::string& path, const std::string& text) {

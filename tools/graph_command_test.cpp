@@ -130,15 +130,15 @@ TEST(GraphCommand, MissingGraphvizGetsAnInstallHint) {
     TempDir dir;
     const std::string scene = dir.write("s.pcsg", testing::kSierpinskiA);
     // An empty PATH: pcsg is started by its full path, but cannot find `dot`.
-    const ChildResult r = runChild({"env", "PATH=" + dir.path(), PCSG_EXECUTABLE, "graph", scene,
-                                    "-o", dir.file("s.svg")});
+    const ChildResult r = runChild(
+        {"env", "PATH=" + dir.path(), PCSG_EXECUTABLE, "graph", scene, "-o", dir.file("s.svg")});
     ASSERT_TRUE(r.started);
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("apt-get install graphviz"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir.file("s.svg")));
     // DOT output needs no Graphviz.
-    const ChildResult dot = runChild({"env", "PATH=" + dir.path(), PCSG_EXECUTABLE, "graph",
-                                      scene, "-o", dir.file("s.dot")});
+    const ChildResult dot = runChild(
+        {"env", "PATH=" + dir.path(), PCSG_EXECUTABLE, "graph", scene, "-o", dir.file("s.dot")});
     EXPECT_EQ(dot.exitCode, 0) << dot.err;
 }
 

@@ -1,10 +1,10 @@
 #include "graph_dot.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-#include <fmt/format.h>
 
 namespace pcsg::tools {
 
@@ -18,10 +18,14 @@ size_t utf8Length(const std::string& s, size_t i) {
     const auto b = static_cast<unsigned char>(s[i]);
     size_t n = 0;
     if (b < 0x80) return 1;
-    if ((b & 0xE0) == 0xC0 && b >= 0xC2) n = 2;
-    else if ((b & 0xF0) == 0xE0) n = 3;
-    else if ((b & 0xF8) == 0xF0 && b <= 0xF4) n = 4;
-    else return 0;
+    if ((b & 0xE0) == 0xC0 && b >= 0xC2)
+        n = 2;
+    else if ((b & 0xF0) == 0xE0)
+        n = 3;
+    else if ((b & 0xF8) == 0xF0 && b <= 0xF4)
+        n = 4;
+    else
+        return 0;
     if (i + n > s.size()) return 0;
     for (size_t k = 1; k < n; ++k)
         if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return 0;
@@ -63,35 +67,58 @@ std::string argList(const Graph& g, uint32_t first, uint32_t count) {
 
 const char* transformName(TransformOp op) {
     switch (op) {
-        case TransformOp::Move: return "move";
-        case TransformOp::Scale: return "scale";
-        case TransformOp::UScale: return "uscale";
-        case TransformOp::RotX: return "rotx";
-        case TransformOp::RotY: return "roty";
-        case TransformOp::RotZ: return "rotz";
-        case TransformOp::Rot: return "rot";
-        case TransformOp::ZShear: return "zshear";
-        case TransformOp::FlipYZ: return "flipyz";
-        case TransformOp::FlipXZ: return "flipxz";
-        case TransformOp::FlipXY: return "flipxy";
-        case TransformOp::Matrix: return "matrix";
+        case TransformOp::Move:
+            return "move";
+        case TransformOp::Scale:
+            return "scale";
+        case TransformOp::UScale:
+            return "uscale";
+        case TransformOp::RotX:
+            return "rotx";
+        case TransformOp::RotY:
+            return "roty";
+        case TransformOp::RotZ:
+            return "rotz";
+        case TransformOp::Rot:
+            return "rot";
+        case TransformOp::ZShear:
+            return "zshear";
+        case TransformOp::FlipYZ:
+            return "flipyz";
+        case TransformOp::FlipXZ:
+            return "flipxz";
+        case TransformOp::FlipXY:
+            return "flipxy";
+        case TransformOp::Matrix:
+            return "matrix";
     }
     return "transform";
 }
 
 const char* primitiveName(PrimitiveKind k) {
     switch (k) {
-        case PrimitiveKind::Sphere: return "sphere";
-        case PrimitiveKind::Cube: return "cube";
-        case PrimitiveKind::Cylinder: return "cylinder";
-        case PrimitiveKind::Cone: return "cone";
-        case PrimitiveKind::Tetrahedron: return "tetrahedron";
-        case PrimitiveKind::Torus: return "torus";
-        case PrimitiveKind::Plane: return "plane";
-        case PrimitiveKind::Empty: return "empty";
-        case PrimitiveKind::Tri1: return "tri1";
-        case PrimitiveKind::Tri2: return "tri2";
-        case PrimitiveKind::Triangle: return "triangle";
+        case PrimitiveKind::Sphere:
+            return "sphere";
+        case PrimitiveKind::Cube:
+            return "cube";
+        case PrimitiveKind::Cylinder:
+            return "cylinder";
+        case PrimitiveKind::Cone:
+            return "cone";
+        case PrimitiveKind::Tetrahedron:
+            return "tetrahedron";
+        case PrimitiveKind::Torus:
+            return "torus";
+        case PrimitiveKind::Plane:
+            return "plane";
+        case PrimitiveKind::Empty:
+            return "empty";
+        case PrimitiveKind::Tri1:
+            return "tri1";
+        case PrimitiveKind::Tri2:
+            return "tri2";
+        case PrimitiveKind::Triangle:
+            return "triangle";
     }
     return "primitive";
 }
@@ -131,14 +158,17 @@ std::string nodeStyle(const Graph& g, NodeId id) {
     switch (n.kind) {
         case NodeKind::Select:
             return R"(shape=box, style="filled,bold", fillcolor="#fde9b0", peripheries=2)";
-        case NodeKind::Transform: return R"(shape=box, style=filled, fillcolor="#dfeaf7")";
-        case NodeKind::Calc: return R"(shape=box, style="rounded,filled", fillcolor="#e4f3dc")";
+        case NodeKind::Transform:
+            return R"(shape=box, style=filled, fillcolor="#dfeaf7")";
+        case NodeKind::Calc:
+            return R"(shape=box, style="rounded,filled", fillcolor="#e4f3dc")";
         case NodeKind::Paint: {
             if (n.payload >= g.materials.size()) return R"(shape=box, style="rounded")";
             double lum = 0;
             const std::string fill = hexColor(g.materials[n.payload].color, &lum);
-            return fmt::format(R"(shape=box, style="rounded,filled", fillcolor="{}", fontcolor="{}")",
-                               fill, lum < 0.45 ? "white" : "black");
+            return fmt::format(
+                R"(shape=box, style="rounded,filled", fillcolor="{}", fontcolor="{}")", fill,
+                lum < 0.45 ? "white" : "black");
         }
         case NodeKind::Union:
         case NodeKind::Intersection:
@@ -233,10 +263,14 @@ std::string nodeLabel(const Graph& g, NodeId id) {
             // A notation-B call assigns all values at once, computed from the caller's.
             return c.simultaneous && c.count > 1 ? s + "\n(simultaneous)" : s;
         }
-        case NodeKind::Paint: return "paint(" + materialName(g, n.payload) + ")";
-        case NodeKind::Union: return "∪";
-        case NodeKind::Intersection: return "∩";
-        case NodeKind::Difference: return "\\";
+        case NodeKind::Paint:
+            return "paint(" + materialName(g, n.payload) + ")";
+        case NodeKind::Union:
+            return "∪";
+        case NodeKind::Intersection:
+            return "∩";
+        case NodeKind::Difference:
+            return "\\";
         case NodeKind::Primitive: {
             if (n.payload >= g.primitives.size()) return "primitive";
             const Primitive& p = g.primitives[n.payload];
@@ -265,11 +299,16 @@ std::string dotEscape(const std::string& text) {
             continue;
         }
         ++i;
-        if (c == '\n') out += "\\n";
-        else if (c == '\\') out += "\\\\";
-        else if (c == '"') out += "\\\"";
-        else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) out += ' ';
-        else out += c;
+        if (c == '\n')
+            out += "\\n";
+        else if (c == '\\')
+            out += "\\\\";
+        else if (c == '"')
+            out += "\\\"";
+        else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+            out += ' ';
+        else
+            out += c;
     }
     return out;
 }

@@ -2,17 +2,15 @@
 // every node is drawn once, the labels, and that Graphviz accepts what it writes.
 #include "graph_dot.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
 #include <set>
-
-#include <unistd.h>
-
-#include <fmt/format.h>
 
 #include "child_process.h"
 
@@ -36,8 +34,8 @@ NodeId transform(Graph& g, TransformOp op, const std::vector<std::string>& args,
     return g.addNode(NodeKind::Transform, static_cast<uint32_t>(g.transforms.size() - 1), {child});
 }
 
-NodeId calc(Graph& g, const std::vector<std::pair<std::string, std::string>>& assigns,
-            NodeId child, bool simultaneous = false) {
+NodeId calc(Graph& g, const std::vector<std::pair<std::string, std::string>>& assigns, NodeId child,
+            bool simultaneous = false) {
     Calc c;
     c.first = static_cast<uint32_t>(g.assignments.size());
     c.count = static_cast<uint32_t>(assigns.size());
@@ -82,8 +80,10 @@ Graph sierpinski() {
     g.materials.push_back(Material{});
     const NodeId s = module(g, "S", "if(c > 0,2,1)", 2);
     setRule(g, s, 1, primitive(g, PrimitiveKind::Tetrahedron));
-    const char* moves[4][3] = {{"0.5", "0.5", "0.5"}, {"-0.5", "-0.5", "0.5"},
-                               {"0.5", "-0.5", "-0.5"}, {"-0.5", "0.5", "-0.5"}};
+    const char* moves[4][3] = {{"0.5", "0.5", "0.5"},
+                               {"-0.5", "-0.5", "0.5"},
+                               {"0.5", "-0.5", "-0.5"},
+                               {"-0.5", "0.5", "-0.5"}};
     std::vector<NodeId> parts;
     for (auto& m : moves)
         parts.push_back(transform(g, TransformOp::Move, {m[0], m[1], m[2]},
@@ -181,17 +181,20 @@ TEST(GraphDot, SierpinskiDotText) {
         EXPECT_EQ(std::stoul((*it)[2]), s);
     }
     EXPECT_EQ(backs, 4u);
-    EXPECT_NE(dot.find(fmt::format("n{} -> n", s) + std::to_string(g.child(s, 0)) + " [label=\"1\"]"),
-              std::string::npos);
-    EXPECT_NE(dot.find(fmt::format("n{} -> n", s) + std::to_string(g.child(s, 1)) + " [label=\"2\"]"),
-              std::string::npos);
+    EXPECT_NE(
+        dot.find(fmt::format("n{} -> n", s) + std::to_string(g.child(s, 0)) + " [label=\"1\"]"),
+        std::string::npos);
+    EXPECT_NE(
+        dot.find(fmt::format("n{} -> n", s) + std::to_string(g.child(s, 1)) + " [label=\"2\"]"),
+        std::string::npos);
 }
 
 TEST(GraphDot, ASharedDefinitionIsDrawnOnce) {
     Graph g;
     // Leaf = sphere \ cube, used by both operands of a union.
-    const NodeId leaf = g.addNode(NodeKind::Difference, kNone,
-                                  {primitive(g, PrimitiveKind::Sphere), primitive(g, PrimitiveKind::Cube)});
+    const NodeId leaf =
+        g.addNode(NodeKind::Difference, kNone,
+                  {primitive(g, PrimitiveKind::Sphere), primitive(g, PrimitiveKind::Cube)});
     const NodeId a = transform(g, TransformOp::RotZ, {"45"}, leaf);
     const NodeId b = transform(g, TransformOp::FlipXZ, {}, leaf);
     g.axiom = g.addNode(NodeKind::Union, kNone, {a, b});
@@ -215,14 +218,16 @@ TEST(GraphDot, MutualRecursionBreaksEveryCycleAtAnSNode) {
     const NodeId t2 = module(g, "T2", "if(n > 0, 2, 1)", 2);
     setRule(g, t1, 1, primitive(g, PrimitiveKind::Tri1));
     setRule(g, t2, 1, primitive(g, PrimitiveKind::Tri2));
-    setRule(g, t1, 2, calc(g, {{"n", "n-1"}},
-                           g.addNode(NodeKind::Union, kNone,
-                                     {transform(g, TransformOp::UScale, {"0.5"}, t1),
-                                      transform(g, TransformOp::UScale, {"0.5"}, t2)})));
-    setRule(g, t2, 2, calc(g, {{"n", "n-1"}},
-                           g.addNode(NodeKind::Union, kNone,
-                                     {transform(g, TransformOp::UScale, {"0.5"}, t2),
-                                      transform(g, TransformOp::UScale, {"0.5"}, t1)})));
+    setRule(g, t1, 2,
+            calc(g, {{"n", "n-1"}},
+                 g.addNode(NodeKind::Union, kNone,
+                           {transform(g, TransformOp::UScale, {"0.5"}, t1),
+                            transform(g, TransformOp::UScale, {"0.5"}, t2)})));
+    setRule(g, t2, 2,
+            calc(g, {{"n", "n-1"}},
+                 g.addNode(NodeKind::Union, kNone,
+                           {transform(g, TransformOp::UScale, {"0.5"}, t2),
+                            transform(g, TransformOp::UScale, {"0.5"}, t1)})));
     g.axiom = calc(g, {{"n", "5"}}, g.addNode(NodeKind::Union, kNone, {t1, t2}));
 
     const DotLayout l = layoutGraph(g);
@@ -266,7 +271,8 @@ TEST(GraphDot, LabelsOfEveryKind) {
     const NodeId torus = primitive(g, PrimitiveKind::Torus, {"R", "r*0.5"});
     const NodeId p = g.addNode(NodeKind::Paint, 1, {torus});
     const NodeId c = calc(g, {{"sd", "rand(x)"}, {"rnd", "sd*2"}}, p);
-    const NodeId i = g.addNode(NodeKind::Intersection, kNone, {c, primitive(g, PrimitiveKind::Plane)});
+    const NodeId i =
+        g.addNode(NodeKind::Intersection, kNone, {c, primitive(g, PrimitiveKind::Plane)});
     g.axiom = transform(g, TransformOp::Matrix,
                         {"1", "0", "0", "0", "1", "0", "0", "0", "1", "0", "0", "2"}, i);
 

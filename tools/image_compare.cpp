@@ -1,10 +1,10 @@
 #include "image_compare.h"
 
+#include <OpenImageIO/imagebufalgo.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <OpenImageIO/imagebufalgo.h>
 
 #include "heat_ramp.h"
 #include "image_format.h"
@@ -29,8 +29,8 @@ bool readLinear(const std::string& path, OIIO::ImageBuf& out, std::string& error
     const OIIO::ImageSpec& spec = in.spec();
     // The file's own pixel type (the buffer holds floats): integer files are sRGB-encoded.
     const OIIO::TypeDesc stored = in.nativespec().format;
-    const bool encoded = stored.basetype == OIIO::TypeDesc::UINT8 ||
-                         stored.basetype == OIIO::TypeDesc::UINT16;
+    const bool encoded =
+        stored.basetype == OIIO::TypeDesc::UINT8 || stored.basetype == OIIO::TypeDesc::UINT16;
     OIIO::ImageSpec rgb(spec.width, spec.height, 3, OIIO::TypeDesc::FLOAT);
     out.reset(rgb);
     const int channels = spec.nchannels;

@@ -4,9 +4,9 @@
 // the pcsg_image library (with tools/image_io.h), the only code that links OpenImageIO.
 #pragma once
 
-#include <string>
-
 #include <OpenImageIO/imagebuf.h>
+
+#include <string>
 
 #include "image_metrics.h"
 

@@ -1,11 +1,10 @@
 #include "image_helper.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
-
-#include <fmt/format.h>
 
 namespace pcsg::tools {
 
@@ -84,9 +83,9 @@ ImageCompareRun compareImagesWithHelper(const std::string& helper, const std::st
                                         const std::string& b, const ImageCompareOptions& o) {
     ImageCompareRun r;
     std::vector<std::string> argv = {helper, "compare", a, b, "--ss", std::to_string(o.ss)};
-    argv.insert(argv.end(), {"--pixel-threshold", formatNumber(o.thresholds.pixelOff),
-                             "--max-off", formatNumber(o.thresholds.maxShareOff),
-                             "--max-mean-error", formatNumber(o.thresholds.maxMeanError)});
+    argv.insert(argv.end(), {"--pixel-threshold", formatNumber(o.thresholds.pixelOff), "--max-off",
+                             formatNumber(o.thresholds.maxShareOff), "--max-mean-error",
+                             formatNumber(o.thresholds.maxMeanError)});
     if (!o.heatMap.empty()) argv.insert(argv.end(), {"--heatmap", o.heatMap});
     if (!o.reducedA.empty()) argv.insert(argv.end(), {"--reduced-a", o.reducedA});
     if (!o.reducedB.empty()) argv.insert(argv.end(), {"--reduced-b", o.reducedB});

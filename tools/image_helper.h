@@ -5,11 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "child_process.h"
 #include "image_metrics.h"
@@ -41,7 +40,7 @@ struct ImageWriteResult {
 // work that makes them; it then waits on its standard input. Either finish() gives it
 // the pixels, or abandon() (or the destructor) stops it.
 class ImageWriter {
-public:
+  public:
     ImageWriter(const std::string& helper, const std::string& path, int width, int height);
 
     // Pipes the pixels (linear RGB floats, row-major from the top-left) to the helper and
@@ -53,7 +52,7 @@ public:
     // truncated input never reaches the user).
     void abandon();
 
-private:
+  private:
     AsyncChild child_;
 };
 

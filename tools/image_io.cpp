@@ -1,5 +1,7 @@
 #include "image_io.h"
 
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -7,9 +9,6 @@
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
-
-#include <OpenImageIO/imageio.h>
-#include <fmt/format.h>
 
 namespace pcsg::tools {
 

@@ -4,9 +4,8 @@
 
 #include <cmath>
 #include <limits>
-#include <optional>
-
 #include <nlohmann/json.hpp>
+#include <optional>
 
 namespace pcsg::tools {
 

@@ -1,9 +1,8 @@
 // Helpers for the tests that read image files back (image_tests, which links OpenImageIO).
 #pragma once
 
-#include <gtest/gtest.h>
-
 #include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
 
 #include <string>
 #include <vector>

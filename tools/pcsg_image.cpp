@@ -11,20 +11,19 @@
 //
 // Exit status: write: 0 written, 2 not (nothing is left behind); compare: 0 the images
 // agree, 1 they differ, 2 the comparison could not run.
+#include <fmt/format.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <new>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
-#include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "image_compare.h"
 #include "image_io.h"

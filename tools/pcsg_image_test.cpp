@@ -2,16 +2,15 @@
 // .png (8-bit sRGB), .tif (16-bit sRGB) and .exr (linear float) files that OpenImageIO
 // reads back with the expected values, and fails cleanly (exit 2, nothing left behind);
 // `compare` prints the metrics as JSON and writes the report's images.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <cstddef>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <OpenImageIO/imageio.h>
-#include <nlohmann/json.hpp>
 
 #include "cli_test_util.h"
 #include "image_test_util.h"
@@ -21,8 +20,8 @@ namespace {
 
 using testing::filesIn;
 using testing::pcsgImage;
-using testing::TempDir;
 using testing::readBack;
+using testing::TempDir;
 
 // A 3x2 image whose values cover the cases: black, white, mid-grey, clamping above 1 and
 // below 0, the linear segment of sRGB near 0.

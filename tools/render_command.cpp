@@ -12,9 +12,10 @@
 // printed beside it.
 //
 // Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
-// run-time error of LANGUAGE.md, reported once with its module path; no image is
+// run-time error of docs/language.md, reported once with its module path; no image is
 // written); 2 something could not run (bad options, an unwritable output file, no
 // pcsg-image).
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -25,8 +26,6 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "eval.h"
@@ -59,7 +58,7 @@ struct RenderCommandOptions {
 
 // A progress bar on standard error, redrawn at most every 1%.
 class ProgressBar {
-public:
+  public:
     void update(double fraction) {
         const int percent = static_cast<int>(fraction * 100);
         if (percent <= shown_.load(std::memory_order_relaxed)) return;
@@ -77,7 +76,7 @@ public:
         if (shown_ >= 0) std::fprintf(stderr, "\r%70s\r", "");
     }
 
-private:
+  private:
     std::mutex mutex_;
     std::atomic<int> shown_{-1};
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
@@ -217,10 +216,9 @@ int runRender(const RenderCommandOptions& o) {
         std::cout << fmt::format("{:<24}{}\n", "graph nodes", g.nodes.size());
         std::cout << fmt::format("{:<24}{}\n", "node visits", result.nodeVisits);
         if (result.instanceBoxes.entries > 0)
-            std::cout << fmt::format("{:<24}{} instances, {}{}\n", "instance-box cache",
-                                     result.instanceBoxes.entries,
-                                     humanBytes(result.instanceBoxes.bytes),
-                                     result.instanceBoxes.full ? " (full)" : "");
+            std::cout << fmt::format(
+                "{:<24}{} instances, {}{}\n", "instance-box cache", result.instanceBoxes.entries,
+                humanBytes(result.instanceBoxes.bytes), result.instanceBoxes.full ? " (full)" : "");
         std::cout << fmt::format("{:<24}{} ({}, {:.3f} s after the render)\n",
                                  "image writer peak RSS", humanBytes(written.peakRssBytes),
                                  kImageHelperName, written.seconds);
@@ -248,15 +246,15 @@ void addRenderCommand(CLI::App& app, int& status) {
         ->required();
     cmd->add_option("--width", o->width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", o->height, "Image height in pixels")->capture_default_str();
-    cmd->add_option("--aa", o->aa,
-                    "Anti-aliasing: N x N stratified samples per pixel (1: none)")
+    cmd->add_option("--aa", o->aa, "Anti-aliasing: N x N stratified samples per pixel (1: none)")
         ->capture_default_str();
     cmd->add_option("--adaptive", o->adaptive,
                     "Adaptive anti-aliasing like POV-Ray's +A T (e.g. 0.3): pixels that differ "
                     "from a neighbour by T or more get 9 more samples (0: off)")
         ->capture_default_str();
-    cmd->add_option("--threads", o->threads, "Worker threads (0: all cores); the image is the "
-                                             "same whatever the count")
+    cmd->add_option("--threads", o->threads,
+                    "Worker threads (0: all cores); the image is the "
+                    "same whatever the count")
         ->capture_default_str();
     cmd->add_flag("--json", o->json, "Print the figures as JSON");
     cmd->add_flag("--no-bounds", o->noBounds,

@@ -4,6 +4,7 @@
 // helper must be named. The helper starts before the render (its start-up overlaps it):
 // a scene that does not compile starts none, one that fails at run time stops it without
 // a word from it, and no exit leaves a helper process behind.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/inotify.h>
 #include <sys/prctl.h>
@@ -15,23 +16,21 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
-#include <nlohmann/json.hpp>
-
 #include "cli_test_util.h"
-#include "image_test_util.h"
 #include "image_format.h"
+#include "image_test_util.h"
 
 namespace pcsg::tools {
 namespace {
 
 using testing::filesIn;
 using testing::pcsg;
-using testing::TempDir;
 using testing::readBack;
+using testing::TempDir;
 
 // Figure 3a with a camera and a light, small enough to render in a moment.
 const char* kScene =
@@ -50,7 +49,7 @@ S if(c > 0, 2, 1)
 // While it lives, descendants of this test process that lose their parent are re-parented
 // to it instead of init: a pcsg-image that pcsg left running or unreaped turns up here.
 class Subreaper {
-public:
+  public:
     Subreaper() { prctl(PR_SET_CHILD_SUBREAPER, 1); }
     ~Subreaper() {
         leftovers();
@@ -85,7 +84,7 @@ size_t occurrences(const std::string& text, const std::string& what) {
 // that does `script` and then, if it gets that far, runs the real helper. An inotify watch
 // on the script sees every start of it (exec opens the file), however soon it is killed.
 class HelperBeside {
-public:
+  public:
     HelperBeside(const TempDir& dir, const std::string& script) : dir_(dir) {
         namespace fs = std::filesystem;
         fs::copy_file(PCSG_EXECUTABLE, dir.file("pcsg"));
@@ -115,7 +114,7 @@ public:
         return any;
     }
 
-private:
+  private:
     const TempDir& dir_;
     int watch_ = -1;
 };

@@ -53,27 +53,41 @@ std::optional<double> povrayTime(const std::string& err, const char* what) {
 
 RenderRun renderNative(const std::string& scene, const std::string& out, int width, int height,
                        const std::vector<std::string>& extra) {
-    std::vector<std::string> argv = {"render", scene, "-o", out, "--width", std::to_string(width),
-                                     "--height", std::to_string(height), "--json"};
+    std::vector<std::string> argv = {"render",   scene,
+                                     "-o",       out,
+                                     "--width",  std::to_string(width),
+                                     "--height", std::to_string(height),
+                                     "--json"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     return runPcsg("the native render", argv);
 }
 
 RenderRun exportPov(const std::string& scene, const std::string& out, int width, int height,
                     const std::vector<std::string>& extra) {
-    std::vector<std::string> argv = {"export-pov", scene, "-o", out, "--width", std::to_string(width),
-                                     "--height", std::to_string(height)};
+    std::vector<std::string> argv = {
+        "export-pov",          scene, "-o", out, "--width", std::to_string(width), "--height",
+        std::to_string(height)};
     argv.insert(argv.end(), extra.begin(), extra.end());
     return runPcsg("export-pov", argv);
 }
 
-RenderRun expandedStats(const std::string& scene) { return runPcsg("stats", {"stats", scene, "--json"}); }
+RenderRun expandedStats(const std::string& scene) {
+    return runPcsg("stats", {"stats", scene, "--json"});
+}
 
 RenderRun renderPovray(const std::string& pov, const std::string& out, int width, int height,
                        const std::vector<std::string>& extra) {
     RenderRun r;
-    std::vector<std::string> argv = {"povray", "+I" + pov, "+O" + out, "+W" + std::to_string(width),
-                                     "+H" + std::to_string(height), "-D", "+FN", "-UA", "-P", "-V"};
+    std::vector<std::string> argv = {"povray",
+                                     "+I" + pov,
+                                     "+O" + out,
+                                     "+W" + std::to_string(width),
+                                     "+H" + std::to_string(height),
+                                     "-D",
+                                     "+FN",
+                                     "-UA",
+                                     "-P",
+                                     "-V"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     r.child = runChild(argv);
     if (!r.child.started) {

@@ -2,11 +2,10 @@
 // render`, this executable) and POV-Ray on exported text. Shared by verify and bench.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "child_process.h"
 
@@ -15,10 +14,10 @@ namespace pcsg::tools {
 struct RenderRun {
     ChildResult child;
     bool ok = false;
-    std::string error;                  // why it failed, with the start of its stderr
-    std::optional<nlohmann::json> json; // what `pcsg ... --json` printed
-    std::optional<double> parseSeconds; // POV-Ray's own parse time
-    std::optional<double> traceSeconds; // POV-Ray's own trace time
+    std::string error;                   // why it failed, with the start of its stderr
+    std::optional<nlohmann::json> json;  // what `pcsg ... --json` printed
+    std::optional<double> parseSeconds;  // POV-Ray's own parse time
+    std::optional<double> traceSeconds;  // POV-Ray's own trace time
 };
 
 // `pcsg render SCENE -o OUT --width W --height H --json [extra...]`.

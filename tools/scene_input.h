@@ -16,7 +16,7 @@ struct CompiledScene {
 };
 
 // Compiles `path` ("-" reads standard input). Diagnostics (a missing file, a directory,
-// every compile error) go to `err` as LANGUAGE.md section 8 prints them.
+// every compile error) go to `err` as docs/language.md section 8 prints them.
 CompiledScene compileScene(const std::string& path, std::ostream& err);
 
 }  // namespace pcsg::tools

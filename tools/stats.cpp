@@ -1,8 +1,7 @@
 #include "stats.h"
 
-#include <sys/resource.h>
-
 #include <fmt/format.h>
+#include <sys/resource.h>
 
 namespace pcsg::tools {
 
@@ -53,7 +52,8 @@ void Stats::print(std::ostream& out) const {
     if (width && height) line("image", fmt::format("{} x {}", *width, *height));
     if (rays) line("rays", fmt::format("{}", *rays));
     if (raysPerSecond) line("rays per second", fmt::format("{:.0f}", *raysPerSecond));
-    if (primitiveEquivalence) line("primitive equivalence", fmt::format("{}", *primitiveEquivalence));
+    if (primitiveEquivalence)
+        line("primitive equivalence", fmt::format("{}", *primitiveEquivalence));
     if (expandedNodes) line("expanded tree nodes", fmt::format("{}", *expandedNodes));
     if (graphBytes) line("graph bytes", humanBytes(*graphBytes));
     if (expandedBytes) line("expanded tree bytes", humanBytes(*expandedBytes));

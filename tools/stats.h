@@ -4,18 +4,17 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 namespace pcsg::tools {
 
 struct Stats {
     std::string scene;
     std::optional<uint32_t> width, height;
-    std::optional<uint64_t> rays;                  // all rays traced (camera, shadow, reflection)
+    std::optional<uint64_t> rays;  // all rays traced (camera, shadow, reflection)
     std::optional<double> raysPerSecond;
     std::optional<uint64_t> primitiveEquivalence;  // primitives the expanded tree holds
     std::optional<uint64_t> expandedNodes;         // all nodes of the expanded tree

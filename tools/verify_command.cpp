@@ -7,6 +7,8 @@
 // images are then reduced by the same K×K box filter, so edge sampling is identical.
 // Reading, reducing and comparing the images is `pcsg-image compare`'s job (a process of
 // its own, the only one that loads OpenImageIO: tools/image_helper.h).
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -14,11 +16,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
-
-#include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "child_process.h"
 #include "commands.h"
@@ -47,8 +47,8 @@ struct VerifyOptions {
 };
 
 struct Side {
-    double seconds = 0;          // wall time of the render process
-    uint64_t peakRssBytes = 0;   // of the render process
+    double seconds = 0;         // wall time of the render process
+    uint64_t peakRssBytes = 0;  // of the render process
     std::optional<double> parseSeconds, traceSeconds;
     std::optional<double> imageWriteSeconds;          // native: pcsg-image write's
     std::optional<uint64_t> imageWriterPeakRssBytes;  // native: pcsg-image write's
@@ -200,19 +200,22 @@ void printResult(const SceneResult& r, std::ostream& out) {
     out << fmt::format("{}: {} ({})\n", r.scene, verdict, r.message);
     if (r.metrics.width > 0) {
         const auto& m = r.metrics;
-        out << fmt::format("  image {}x{}: mean abs error {:.4f}, RMSE {:.4f}, PSNR {:.1f} dB, "
-                           "pixels off {:.2f}%, largest difference {:.3f} at ({}, {})\n",
-                           m.width, m.height, m.meanAbsError, m.rmse, m.psnr, 100 * m.shareOff,
-                           m.maxError, m.maxX, m.maxY);
-        out << fmt::format("  memory: graph {} vs expanded tree {} ({}), native peak RSS {} vs "
-                           "POV-Ray {} ({})\n",
-                           opt(r.graphBytes), opt(r.expandedBytes), ratio(r.expandedBytes, r.graphBytes),
-                           humanBytes(r.native.peakRssBytes), humanBytes(r.povray.peakRssBytes),
-                           ratio(r.povray.peakRssBytes, r.native.peakRssBytes));
-        out << fmt::format("  time: native {:.2f} s, POV-Ray {:.2f} s{}; primitives {}\n",
-                           r.native.seconds, r.povray.seconds,
-                           r.povray.parseSeconds ? fmt::format(" ({:.2f} s parsing)", *r.povray.parseSeconds) : "",
-                           opt(r.primitives, false));
+        out << fmt::format(
+            "  image {}x{}: mean abs error {:.4f}, RMSE {:.4f}, PSNR {:.1f} dB, "
+            "pixels off {:.2f}%, largest difference {:.3f} at ({}, {})\n",
+            m.width, m.height, m.meanAbsError, m.rmse, m.psnr, 100 * m.shareOff, m.maxError, m.maxX,
+            m.maxY);
+        out << fmt::format(
+            "  memory: graph {} vs expanded tree {} ({}), native peak RSS {} vs "
+            "POV-Ray {} ({})\n",
+            opt(r.graphBytes), opt(r.expandedBytes), ratio(r.expandedBytes, r.graphBytes),
+            humanBytes(r.native.peakRssBytes), humanBytes(r.povray.peakRssBytes),
+            ratio(r.povray.peakRssBytes, r.native.peakRssBytes));
+        out << fmt::format(
+            "  time: native {:.2f} s, POV-Ray {:.2f} s{}; primitives {}\n", r.native.seconds,
+            r.povray.seconds,
+            r.povray.parseSeconds ? fmt::format(" ({:.2f} s parsing)", *r.povray.parseSeconds) : "",
+            opt(r.primitives, false));
     }
 }
 
@@ -263,12 +266,23 @@ std::string htmlEscape(const std::string& s) {
     std::string out;
     for (char c : s) {
         switch (c) {
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '&': out += "&amp;"; break;
-            case '"': out += "&quot;"; break;
-            case '\'': out += "&#39;"; break;
-            default: out += c;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '&':
+                out += "&amp;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            case '\'':
+                out += "&#39;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
@@ -425,7 +439,9 @@ std::string heatLegend(double pixelOff) {
         const bool first = i == 0, last = i + 1 == kHeatStops.size();
         const double d = double(kHeatStops[i].at) * kHeatFullScale;
         ticks += fmt::format("<span{} style=\"left:{:.2f}%\">{}{:.3g}</span>",
-                             first ? " class=first" : last ? " class=last" : "",
+                             first  ? " class=first"
+                             : last ? " class=last"
+                                    : "",
                              100.0 * kHeatStops[i].at, last ? "&ge;&nbsp;" : "", d);
     }
     return fmt::format(
@@ -644,7 +660,8 @@ int runVerify(VerifyOptions o) {
         for (const auto& e : fs::directory_iterator(o.allDir, ec))
             if (e.path().extension() == ".pcsg") found.push_back(e.path().string());
         if (ec) {
-            std::cerr << "pcsg verify: cannot read directory " << o.allDir << ": " << ec.message() << "\n";
+            std::cerr << "pcsg verify: cannot read directory " << o.allDir << ": " << ec.message()
+                      << "\n";
             return 2;
         }
         std::sort(found.begin(), found.end());
@@ -710,7 +727,8 @@ int runVerify(VerifyOptions o) {
         std::cout << fmt::format("{} of {} scene(s) agree", agree, results.size());
         if (!o.reportDir.empty())
             std::cout << "; report: " << (root / "index.html").string();
-        else if (o.keep) std::cout << "; images kept in " << root.string();
+        else if (o.keep)
+            std::cout << "; images kept in " << root.string();
         std::cout << "\n";
     }
     if (temporary) fs::remove_all(root, ec);
@@ -735,17 +753,21 @@ void addVerifyCommand(CLI::App& app, int& status) {
     cmd->add_option("--all", o->allDir, "Verify every .pcsg file in this directory");
     cmd->add_option("--width", o->width, "Image width after reduction")->capture_default_str();
     cmd->add_option("--height", o->height, "Image height after reduction")->capture_default_str();
-    cmd->add_option("--ss", o->ss, "Supersampling factor K: both render K*W x K*H")->capture_default_str();
+    cmd->add_option("--ss", o->ss, "Supersampling factor K: both render K*W x K*H")
+        ->capture_default_str();
     cmd->add_option("--threads", o->threads, "Threads for both renderers (default: all cores)");
     cmd->add_option("--report", o->reportDir,
                     "Write an HTML report into this directory; open DIR/index.html");
     cmd->add_option("--pov", o->povFile, "Render this POV-Ray file instead of exporting the scene");
     cmd->add_option("--pixel-threshold", o->thresholds.pixelOff,
-                    "A pixel is off when a channel differs by more than this (0..1)")->capture_default_str();
+                    "A pixel is off when a channel differs by more than this (0..1)")
+        ->capture_default_str();
     cmd->add_option("--max-off", o->thresholds.maxShareOff,
-                    "Agree only if at most this share of pixels is off")->capture_default_str();
+                    "Agree only if at most this share of pixels is off")
+        ->capture_default_str();
     cmd->add_option("--max-mean-error", o->thresholds.maxMeanError,
-                    "Agree only if the mean absolute error is at most this")->capture_default_str();
+                    "Agree only if the mean absolute error is at most this")
+        ->capture_default_str();
     cmd->add_flag("--json", o->json, "Print the results as JSON");
     cmd->add_flag("--keep", o->keep, "Keep the images (in a temporary directory) without --report");
     cmd->callback([o, &status] { status = runVerify(*o); });

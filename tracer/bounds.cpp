@@ -18,17 +18,17 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // What the forward pass records per (node, depth) for the box pass.
 struct Level {
-    std::vector<uint8_t> reached;                    // per node
-    std::vector<IntervalAffine> matrix;              // per non-constant T-node
-    std::vector<uint8_t> matrixOk;                   // the matrix could be evaluated
-    std::vector<std::array<Interval, 9>> args;       // per non-constant primitive
+    std::vector<uint8_t> reached;               // per node
+    std::vector<IntervalAffine> matrix;         // per non-constant T-node
+    std::vector<uint8_t> matrixOk;              // the matrix could be evaluated
+    std::vector<std::array<Interval, 9>> args;  // per non-constant primitive
     std::vector<uint8_t> argsOk;
-    std::vector<std::vector<uint32_t>> rules;        // per S-node (module index)
-    std::vector<uint8_t> mayFail;                    // per module: its selection may be an error
+    std::vector<std::vector<uint32_t>> rules;  // per S-node (module index)
+    std::vector<uint8_t> mayFail;              // per module: its selection may be an error
 };
 
 class Analysis {
-public:
+  public:
     Analysis(const Graph& g, const BoundsOptions& opt) : g_(g), opt_(opt), n_(g.nodes.size()) {}
 
     Bounds run() {
@@ -57,11 +57,11 @@ public:
         return out;
     }
 
-private:
+  private:
     const Graph& g_;
     BoundsOptions opt_;
     size_t n_;
-    std::vector<NodeId> topo_;  // parents before children, edges into S-nodes ignored
+    std::vector<NodeId> topo_;              // parents before children, edges into S-nodes ignored
     std::vector<int32_t> tIndex_, pIndex_;  // compact indices of non-constant T / primitives
     size_t tCount_ = 0, pCount_ = 0;
     uint32_t levels_ = 0;
@@ -158,7 +158,8 @@ private:
                 if (!transformInterval(g_, n, st, m)) return;
                 if (rec.matrixOk[ti]) {
                     for (int i = 0; i < 3; ++i) {
-                        for (int j = 0; j < 3; ++j) rec.matrix[ti].l[i][j] = join(rec.matrix[ti].l[i][j], m.l[i][j]);
+                        for (int j = 0; j < 3; ++j)
+                            rec.matrix[ti].l[i][j] = join(rec.matrix[ti].l[i][j], m.l[i][j]);
                         rec.matrix[ti].t[i] = join(rec.matrix[ti].t[i], m.t[i]);
                     }
                 } else {
@@ -168,7 +169,9 @@ private:
                 push(g_.child(n), st);
                 return;
             }
-            case NodeKind::Paint: push(g_.child(n), st); return;
+            case NodeKind::Paint:
+                push(g_.child(n), st);
+                return;
             case NodeKind::Union:
             case NodeKind::Intersection:
             case NodeKind::Difference:
@@ -181,7 +184,8 @@ private:
                 if (!primitiveArgsInterval(g_, n, st, a.data())) return;
                 const uint32_t count = g_.primitives[node.payload].argCount;
                 if (rec.argsOk[pi]) {
-                    for (uint32_t i = 0; i < count; ++i) rec.args[pi][i] = join(rec.args[pi][i], a[i]);
+                    for (uint32_t i = 0; i < count; ++i)
+                        rec.args[pi][i] = join(rec.args[pi][i], a[i]);
                 } else {
                     rec.args[pi] = a;
                     rec.argsOk[pi] = 1;
@@ -303,7 +307,8 @@ private:
     Box apply(NodeId n, const Level& rec, ChildBox child) const {
         const Node& node = g_.nodes[n];
         switch (node.kind) {
-            case NodeKind::Primitive: return primitiveBoxAt(n, rec);
+            case NodeKind::Primitive:
+                return primitiveBoxAt(n, rec);
             case NodeKind::Select: {
                 // A run-time error is "there" too: a ray that reaches it must meet it.
                 if (rec.mayFail[moduleOf(n)]) return Box::everything();
@@ -312,7 +317,8 @@ private:
                 return b;
             }
             case NodeKind::Calc:
-            case NodeKind::Paint: return child(g_.child(n));
+            case NodeKind::Paint:
+                return child(g_.child(n));
             case NodeKind::Transform: {
                 const Box c = child(g_.child(n));
                 const int32_t ti = tIndex_[n];
@@ -327,10 +333,12 @@ private:
             }
             case NodeKind::Intersection: {
                 Box b = Box::everything();
-                for (uint32_t i = 0; i < node.childCount; ++i) b = intersect(b, child(g_.child(n, i)));
+                for (uint32_t i = 0; i < node.childCount; ++i)
+                    b = intersect(b, child(g_.child(n, i)));
                 return b.isEmpty() ? Box::empty() : b;
             }
-            case NodeKind::Difference: return node.childCount ? child(g_.child(n, 0)) : Box::empty();
+            case NodeKind::Difference:
+                return node.childCount ? child(g_.child(n, 0)) : Box::empty();
         }
         return Box::everything();
     }
@@ -396,7 +404,8 @@ private:
                 if (!rec.reached[n]) continue;
                 cur[n] = apply(n, rec, child);
                 node[n] = unite(node[n], cur[n]);
-                if (isSelect(n)) out.depthBox[static_cast<size_t>(moduleOf(n)) * levels_ + d] = cur[n];
+                if (isSelect(n))
+                    out.depthBox[static_cast<size_t>(moduleOf(n)) * levels_ + d] = cur[n];
             }
         }
         if (summary_)
@@ -428,7 +437,9 @@ Box growBox(const Box& b, double rel, double abs) {
     return r;
 }
 
-Box paddedBox(const Box& b) { return growBox(b, 1e-9, 1e-10); }
+Box paddedBox(const Box& b) {
+    return growBox(b, 1e-9, 1e-10);
+}
 
 Bounds computeBounds(const Graph& g, const BoundsOptions& options) {
     return Analysis(g, options).run();

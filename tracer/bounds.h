@@ -49,8 +49,8 @@ struct Bounds {
     std::vector<Box> depthBox;
 
     // Statistics for --json and tests.
-    uint32_t infiniteNodes = 0;     // nodes left with an unbounded box
-    uint32_t summaryFrom = 0;       // first depth handled by the summary fixpoint (0: none)
+    uint32_t infiniteNodes = 0;  // nodes left with an unbounded box
+    uint32_t summaryFrom = 0;    // first depth handled by the summary fixpoint (0: none)
 
     const Box& select(const Graph& g, NodeId n, uint32_t depth) const {
         const uint32_t m = g.nodes[n].payload;

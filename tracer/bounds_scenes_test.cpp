@@ -1,4 +1,4 @@
-// Soundness of the hyper-bounding boxes on every scene in scenes/ (issue 3): expand each
+// Soundness of the hyper-bounding boxes on every scene in scenes/: expand each
 // scene completely and check that every primitive instance lies inside the box of every
 // node on its path, in that node's frame, and inside the per-depth box of every S-node on
 // its path. Nothing may ever be culled that is there.
@@ -24,7 +24,6 @@
 // scene (in depth-first order, so the sample is deterministic); the Release build checks
 // them all.
 #include <gtest/gtest.h>
-#include "sanitizer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -38,6 +37,7 @@
 #include "compiler.h"
 #include "eval.h"
 #include "primitives.h"
+#include "sanitizer.h"
 
 namespace pcsg::tracer {
 namespace {
@@ -94,7 +94,7 @@ struct SoundnessReport {
     bool truncated = false;     // stopped at the instance limit
 };
 
-// The streaming check: a depth-first expansion of the graph (LANGUAGE.md semantics,
+// The streaming check: a depth-first expansion of the graph (docs/language.md semantics,
 // through eval.h) that checks each primitive instance against the boxes on its path.
 class StreamingSoundness {
   public:

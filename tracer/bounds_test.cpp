@@ -69,13 +69,15 @@ size_t checkSound(const Graph& g, const Bounds& b, const std::vector<testing::In
         bool clipped = false;
         for (size_t j = 0; j < inst.path.size(); ++j) {
             const NodeKind k = g.nodes[inst.path[j].node].kind;
-            if (k == NodeKind::Intersection || (k == NodeKind::Difference && inst.path[j].childTaken > 0)) {
+            if (k == NodeKind::Intersection ||
+                (k == NodeKind::Difference && inst.path[j].childTaken > 0)) {
                 clip = j;
                 clipped = true;
             }
         }
         for (size_t j = clipped ? clip + 1 : 0; j < inst.path.size(); ++j)
-            if (!checkCorners(pb, inst.toWorld, inst.path[j], "a primitive instance")) return checks;
+            if (!checkCorners(pb, inst.toWorld, inst.path[j], "a primitive instance"))
+                return checks;
         if (!clipped) continue;
         const auto& cn = inst.path[clip];
         const Box& cb = b.node[cn.node];
@@ -249,8 +251,9 @@ S 1
                 frame[0] = -4 + 7.0 * i / 200;
                 frame[1] = -2 + 8.0 * j / 50;
                 const double v = evalExpr(g, e, EvalState{frame.data(), kRootPath});
-                ASSERT_TRUE(iv.contains(v)) << "arg " << k << " value " << v << " not in [" << iv.lo
-                                            << ", " << iv.hi << "] at x=" << frame[0] << " y=" << frame[1];
+                ASSERT_TRUE(iv.contains(v))
+                    << "arg " << k << " value " << v << " not in [" << iv.lo << ", " << iv.hi
+                    << "] at x=" << frame[0] << " y=" << frame[1];
             }
     }
 }

@@ -1,4 +1,4 @@
-// The perspective pin-hole camera of LANGUAGE.md section 7, reproducing POV-Ray 3.7.0's
+// The perspective pin-hole camera of docs/language.md section 7, reproducing POV-Ray 3.7.0's
 // camera exactly, so that `pcsg verify` can compare the two images pixel by pixel.
 //
 // The POV-Ray camera block that matches this camera (the exporter writes it)
@@ -47,7 +47,7 @@
 //         direction = D d
 //         right = (h > 0 ? +R : -R) s  = -R s here, i.e. R normalize(d x sky)
 //     With sky <0,0,1> and d = +y, s = -x, so right = +x R: +x is on the right of the
-//     image and the scene is right-handed, as LANGUAGE.md requires.
+//     image and the scene is right-handed, as docs/language.md requires.
 //  3. A pixel (px, py), px = 0..W-1 from the left, py = 0..H-1 from the top, is sampled
 //     at its centre; sub-pixel samples use the same formula with fractional offsets:
 //         x0 = (px + 0.5) / W - 0.5,   y0 = 0.5 - (py + 0.5) / H
@@ -69,7 +69,7 @@ struct Ray {
 };
 
 class PinholeCamera {
-public:
+  public:
     PinholeCamera(const Camera& cam, int width, int height);
 
     // The primary ray through image position (x, y), in pixels from the top-left corner
@@ -80,7 +80,7 @@ public:
     const Vec3& right() const { return right_; }
     const Vec3& up() const { return up_; }
 
-private:
+  private:
     Vec3 location_;
     Vec3 direction_, right_, up_;  // POV-Ray's vectors after look_at and angle
     double width_, height_;

@@ -147,7 +147,7 @@ TEST(PinholeCamera, VerticalFieldFollowsFromTheAspectRatio) {
 }
 
 TEST(PinholeCamera, PlusXIsOnTheRightLookingAlongY) {
-    // LANGUAGE.md section 7: with sky <0,0,1>, looking along +y, +x is to the right.
+    // docs/language.md section 7: with sky <0,0,1>, looking along +y, +x is to the right.
     const PinholeCamera pc(makeCamera({0, -5, 0}, {0, 0, 0}, {0, 0, 1}, 40), 64, 48);
     const Vec3 right = ray(pc, 60, 24), left = ray(pc, 4, 24);
     const Vec3 top = ray(pc, 32, 2), bottom = ray(pc, 32, 46);

@@ -183,8 +183,7 @@ class ExpansionBuilder {
         x.material = material;
         x.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
         x.matrices = static_cast<uint32_t>(pending_.size() - pendingBase);
-        out_.matrices_.insert(out_.matrices_.end(), pending_.begin() + pendingBase,
-                              pending_.end());
+        out_.matrices_.insert(out_.matrices_.end(), pending_.begin() + pendingBase, pending_.end());
         x.box = inside.isEmpty() ? Box::empty() : paddedBox(transformBox(edge, inside));
         return x;
     }
@@ -222,7 +221,8 @@ class ExpansionBuilder {
             copy.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
             copy.matrices = static_cast<uint32_t>(chain.size());
             out_.matrices_.insert(out_.matrices_.end(), chain.begin(), chain.end());
-            copy.box = child.box.isEmpty() ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
+            copy.box =
+                child.box.isEmpty() ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
             copy.bvh = kNone;
             out_.nodes_.push_back(copy);
             items.push_back(static_cast<uint32_t>(out_.nodes_.size() - 1));
@@ -325,8 +325,8 @@ uint64_t ExpandedInstance::keyOf(const Node& node, uint64_t path) const {
     return path;
 }
 
-bool ExpandedInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& hit,
-                             const Use& use, bool anyHit, Scratch& s) const {
+bool ExpandedInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
+                             bool anyHit, Scratch& s) const {
     if (root_ == kNone) return false;
     double t0 = tmin, t1 = tmax;
     if (!clipToBox(nodes_[root_].box, r.o, r.d, t0, t1)) return false;
@@ -341,8 +341,8 @@ size_t ExpandedInstance::spans(const LocalRay& r, double tmin, double tmax,
     return spansAt(root_, r, tmin, tmax, spans, use, s);
 }
 
-bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax,
-                               Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
+bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                               const Use& use, bool anyHit, Scratch& s) const {
     ++s.visits;
     const Node& node = nodes_[n];
     const LocalRay rr = enter(node, r);
@@ -357,7 +357,8 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                     sp[k].in.t > tmin ? &sp[k].in : (sp[k].out.t > tmin ? &sp[k].out : nullptr);
                 if (!b) continue;
                 // (the key is replayed only for a tie or a new nearest hit)
-                if (!(b->t < tmax) && !(b->t == tmax && hit.valid && keyOf(node, use.path) < hit.key))
+                if (!(b->t < tmax) &&
+                    !(b->t == tmax && hit.valid && keyOf(node, use.path) < hit.key))
                     break;
                 hit = Hit{b->t, b->normal, material, true, keyOf(node, use.path)};
                 tmax = b->t;
@@ -371,7 +372,8 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             triangleCorners(node.prim, args_.data() + node.first, corners);
             Boundary b;
             if (intersectTriangle(corners[0], corners[1], corners[2], rr.o, rr.d, tmin,
-                                  std::nextafter(tmax, std::numeric_limits<double>::infinity()), b) &&
+                                  std::nextafter(tmax, std::numeric_limits<double>::infinity()),
+                                  b) &&
                 (b.t < tmax || (b.t == tmax && hit.valid && keyOf(node, use.path) < hit.key))) {
                 hit = Hit{b.t, b.normal, material, true, keyOf(node, use.path)};
                 tmax = b.t;
@@ -419,8 +421,8 @@ bool ExpandedInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         });
 }
 
-bool ExpandedInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax,
-                                Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
+bool ExpandedInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                                const Use& use, bool anyHit, Scratch& s) const {
     const BvhNode& bn = bvh_[b];
     if (bn.left == kNone)
         return firstOfNodes(items_.data() + bn.first, bn.count, r, tmin, tmax, hit, use, anyHit, s);
@@ -444,7 +446,8 @@ size_t ExpandedInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
     const size_t base = spans.size();
     size_t count = 0;
     switch (node.kind) {
-        case Kind::Triangle: return 0;  // surfaces: never under ∩ or \ (the compiler checks)
+        case Kind::Triangle:
+            return 0;  // surfaces: never under ∩ or \ (the compiler checks)
         case Kind::Solid: {
             Span sp[kMaxPrimitiveSpans];
             const int k = intersectSolid(node.prim, args_.data() + node.first, rr.o, rr.d, sp);

@@ -1,7 +1,7 @@
 // Expanded instances: the tracer's lazily filled, memory-bounded cache of small sub-graph
 // instances unrolled into flat arrays (the seed paper's future-work idea of keeping
-// states of the graph, in the form issue 6 names: "a lazily filled cache of expanded
-// sub-graph instances bounded in memory").
+// states of the graph, as a lazily filled cache of expanded sub-graph instances bounded
+// in memory).
 //
 // Deep in a recursion the graph walk spends its time on bookkeeping, not geometry: each
 // ray that reaches a flower head evaluates the selection and the C-node of every petal
@@ -83,8 +83,8 @@ class ExpandedInstance {
 
     // The nearest surface with tmin < t < tmax (or at tmax, winning the tie) in the
     // instance, the ray in the S-node's frame; `hit.normal` comes back in that frame.
-    bool first(const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
-               bool anyHit, Scratch& s) const;
+    bool first(const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use, bool anyHit,
+               Scratch& s) const;
     // The instance's span list, appended to `spans` (normals in the S-node's frame).
     size_t spans(const LocalRay& r, double tmin, double tmax, std::vector<Span>& spans,
                  const Use& use, Scratch& s) const;
@@ -100,8 +100,8 @@ class ExpandedInstance {
   private:
     friend class ExpansionBuilder;
 
-    bool firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit,
-                 const Use& use, bool anyHit, Scratch& s) const;
+    bool firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
+                 bool anyHit, Scratch& s) const;
     size_t spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
                    std::vector<Span>& spans, const Use& use, Scratch& s) const;
     bool firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r, double tmin,
@@ -132,8 +132,7 @@ class ExpansionCache {
     // The expanded instance of the S-node instance (select, frame, path) at `depth`, or
     // nullptr (not worth expanding yet, or too large). Throws RuntimeError (without this
     // S-node in its module path) when unrolling meets a run-time error.
-    const ExpandedInstance* get(NodeId select, uint32_t depth, const double* frame,
-                                uint64_t path);
+    const ExpandedInstance* get(NodeId select, uint32_t depth, const double* frame, uint64_t path);
 
     ExpandedInstance::Scratch& scratch() { return scratch_; }
     uint64_t expansions() const { return expansions_; }

@@ -236,7 +236,8 @@ class InstanceBoxes::Worker {
 
 // ---------------------------------------------------------------------------------------
 
-InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds, const InstanceBoxOptions& options)
+InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
+                             const InstanceBoxOptions& options)
     : g_(g),
       bounds_(bounds),
       opt_(options),
@@ -264,9 +265,13 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds, const Instanc
 
 InstanceBoxes::~InstanceBoxes() = default;
 
-InstanceBoxes::WorkerPtr InstanceBoxes::makeWorker() const { return WorkerPtr(new Worker(*this)); }
+InstanceBoxes::WorkerPtr InstanceBoxes::makeWorker() const {
+    return WorkerPtr(new Worker(*this));
+}
 
-void InstanceBoxes::WorkerDeleter::operator()(Worker* w) const { delete w; }
+void InstanceBoxes::WorkerDeleter::operator()(Worker* w) const {
+    delete w;
+}
 
 bool InstanceBoxes::useAt(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return false;
@@ -295,8 +300,12 @@ InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint
     return {a | 1, b};  // a != 0: never the empty slot
 }
 
-bool InstanceBoxes::find(const Key& k, Stored& out) const { return table_->find(k, out); }
-void InstanceBoxes::insert(const Key& k, const Stored& s) const { table_->insert(k, s); }
+bool InstanceBoxes::find(const Key& k, Stored& out) const {
+    return table_->find(k, out);
+}
+void InstanceBoxes::insert(const Key& k, const Stored& s) const {
+    table_->insert(k, s);
+}
 
 // The trial of exact boxes at (module, depth): do they pay?
 void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const {

@@ -93,9 +93,12 @@ class SoundnessWalk {
                 break;
             }
             case NodeKind::Transform:
-                walk(g_.child(n), frame, path, depth, world * transformMatrix(g_, n, st), checkFrom);
+                walk(g_.child(n), frame, path, depth, world * transformMatrix(g_, n, st),
+                     checkFrom);
                 break;
-            case NodeKind::Paint: walk(g_.child(n), frame, path, depth, world, checkFrom); break;
+            case NodeKind::Paint:
+                walk(g_.child(n), frame, path, depth, world, checkFrom);
+                break;
             case NodeKind::Union:
             case NodeKind::Intersection:
             case NodeKind::Difference:

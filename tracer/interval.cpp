@@ -13,8 +13,12 @@ namespace {
 constexpr double kInf = Interval::kInf;
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
-Interval reals(double lo, double hi, bool nan = false) { return Interval{lo, hi, nan}; }
-Interval nanOnly() { return Interval{kInf, -kInf, true}; }
+Interval reals(double lo, double hi, bool nan = false) {
+    return Interval{lo, hi, nan};
+}
+Interval nanOnly() {
+    return Interval{kInf, -kInf, true};
+}
 Interval boolean(bool canTrue, bool canFalse) {
     if (canTrue && canFalse) return Interval::of(0, 1);
     if (canTrue) return Interval::point(1);
@@ -22,11 +26,17 @@ Interval boolean(bool canTrue, bool canFalse) {
     return Interval::bottom();
 }
 
-bool hasInfEnd(const Interval& a) { return a.hasReals() && (std::isinf(a.lo) || std::isinf(a.hi)); }
-bool hasNonZero(const Interval& a) { return a.hasReals() && !(a.lo == 0 && a.hi == 0); }
+bool hasInfEnd(const Interval& a) {
+    return a.hasReals() && (std::isinf(a.lo) || std::isinf(a.hi));
+}
+bool hasNonZero(const Interval& a) {
+    return a.hasReals() && !(a.lo == 0 && a.hi == 0);
+}
 
 // x * y with 0 * inf = 0 (the ends of a set of finite values).
-double mulEnd(double x, double y) { return (x == 0 || y == 0) ? 0.0 : x * y; }
+double mulEnd(double x, double y) {
+    return (x == 0 || y == 0) ? 0.0 : x * y;
+}
 
 Interval add(const Interval& a, const Interval& b) {
     bool nan = a.nan || b.nan;
@@ -38,15 +48,20 @@ Interval add(const Interval& a, const Interval& b) {
     return reals(lo, hi, nan);
 }
 
-Interval neg(const Interval& a) { return Interval{-a.hi, -a.lo, a.nan}; }
+Interval neg(const Interval& a) {
+    return Interval{-a.hi, -a.lo, a.nan};
+}
 
-Interval sub(const Interval& a, const Interval& b) { return add(a, neg(b)); }
+Interval sub(const Interval& a, const Interval& b) {
+    return add(a, neg(b));
+}
 
 Interval mul(const Interval& a, const Interval& b) {
     bool nan = a.nan || b.nan;
     if (!a.hasReals() || !b.hasReals()) return nan ? nanOnly() : Interval::bottom();
     if ((a.contains(0) && hasInfEnd(b)) || (b.contains(0) && hasInfEnd(a))) nan = true;
-    const double p[4] = {mulEnd(a.lo, b.lo), mulEnd(a.lo, b.hi), mulEnd(a.hi, b.lo), mulEnd(a.hi, b.hi)};
+    const double p[4] = {mulEnd(a.lo, b.lo), mulEnd(a.lo, b.hi), mulEnd(a.hi, b.lo),
+                         mulEnd(a.hi, b.hi)};
     return reals(*std::min_element(p, p + 4), *std::max_element(p, p + 4), nan);
 }
 
@@ -196,39 +211,68 @@ Interval compare(Op op, const Interval& a, const Interval& b) {
     const bool samePoint = r && a.lo == a.hi && b.lo == b.hi && a.lo == b.lo;
     const bool overlap = r && std::max(a.lo, b.lo) <= std::min(a.hi, b.hi);
     switch (op) {
-        case Op::Lt: return boolean(r && a.lo < b.hi, nan || (r && a.hi >= b.lo));
-        case Op::Le: return boolean(r && a.lo <= b.hi, nan || (r && a.hi > b.lo));
-        case Op::Gt: return boolean(r && a.hi > b.lo, nan || (r && a.lo <= b.hi));
-        case Op::Ge: return boolean(r && a.hi >= b.lo, nan || (r && a.lo < b.hi));
-        case Op::Eq: return boolean(overlap, nan || (r && !samePoint));
-        case Op::Ne: return boolean(nan || (r && !samePoint), overlap);
-        default: return Interval::all();
+        case Op::Lt:
+            return boolean(r && a.lo < b.hi, nan || (r && a.hi >= b.lo));
+        case Op::Le:
+            return boolean(r && a.lo <= b.hi, nan || (r && a.hi > b.lo));
+        case Op::Gt:
+            return boolean(r && a.hi > b.lo, nan || (r && a.lo <= b.hi));
+        case Op::Ge:
+            return boolean(r && a.hi >= b.lo, nan || (r && a.lo < b.hi));
+        case Op::Eq:
+            return boolean(overlap, nan || (r && !samePoint));
+        case Op::Ne:
+            return boolean(nan || (r && !samePoint), overlap);
+        default:
+            return Interval::all();
     }
 }
 
 Interval callFunc(Func f, const Interval* a, uint32_t n, uint64_t seed) {
     switch (f) {
-        case Func::Sin: return sinInterval(a[0]);
-        case Func::Cos: return cosInterval(a[0]);
-        case Func::Tan: return tanInterval(a[0]);
-        case Func::Asin: return increasing(a[0], [](double x) { return std::asin(x) / kDegToRad; }, -1, 1);
-        case Func::Acos: return decreasing(a[0], [](double x) { return std::acos(x) / kDegToRad; }, -1, 1);
-        case Func::Atan: return increasing(a[0], [](double x) { return std::atan(x) / kDegToRad; });
+        case Func::Sin:
+            return sinInterval(a[0]);
+        case Func::Cos:
+            return cosInterval(a[0]);
+        case Func::Tan:
+            return tanInterval(a[0]);
+        case Func::Asin:
+            return increasing(
+                a[0], [](double x) { return std::asin(x) / kDegToRad; }, -1, 1);
+        case Func::Acos:
+            return decreasing(
+                a[0], [](double x) { return std::acos(x) / kDegToRad; }, -1, 1);
+        case Func::Atan:
+            return increasing(a[0], [](double x) { return std::atan(x) / kDegToRad; });
         case Func::Atan2:
             if (a[0].isPoint() && a[1].isPoint())
                 return Interval::point(std::atan2(a[0].lo, a[1].lo) / kDegToRad);
             return reals(-180, 180, a[0].nan || a[1].nan);
-        case Func::Sqrt: return increasing(a[0], [](double x) { return std::sqrt(x); }, 0, kInf);
-        case Func::Exp: return increasing(a[0], [](double x) { return std::exp(x); });
-        case Func::Ln: return increasing(a[0], [](double x) { return std::log(x); }, 0, kInf);
-        case Func::Log10: return increasing(a[0], [](double x) { return std::log10(x); }, 0, kInf);
-        case Func::Pow: return powInterval(a[0], a[1]);
-        case Func::Abs: return absInterval(a[0]);
-        case Func::Floor: return increasing(a[0], [](double x) { return std::floor(x); });
-        case Func::Ceil: return increasing(a[0], [](double x) { return std::ceil(x); });
-        case Func::Min: return minMax(a, n, true);
-        case Func::Max: return minMax(a, n, false);
-        case Func::Mod: return fmodInterval(a[0], a[1]);
+        case Func::Sqrt:
+            return increasing(
+                a[0], [](double x) { return std::sqrt(x); }, 0, kInf);
+        case Func::Exp:
+            return increasing(a[0], [](double x) { return std::exp(x); });
+        case Func::Ln:
+            return increasing(
+                a[0], [](double x) { return std::log(x); }, 0, kInf);
+        case Func::Log10:
+            return increasing(
+                a[0], [](double x) { return std::log10(x); }, 0, kInf);
+        case Func::Pow:
+            return powInterval(a[0], a[1]);
+        case Func::Abs:
+            return absInterval(a[0]);
+        case Func::Floor:
+            return increasing(a[0], [](double x) { return std::floor(x); });
+        case Func::Ceil:
+            return increasing(a[0], [](double x) { return std::ceil(x); });
+        case Func::Min:
+            return minMax(a, n, true);
+        case Func::Max:
+            return minMax(a, n, false);
+        case Func::Mod:
+            return fmodInterval(a[0], a[1]);
         case Func::Clamp: {
             const Interval m[2] = {a[0], a[1]};
             const Interval lower = minMax(m, 2, false);
@@ -265,14 +309,18 @@ struct IntervalVm {
         while (pc < end) {
             const Instr& in = code[pc++];
             switch (in.op) {
-                case Op::Const: stack.push_back(Interval::point(in.imm)); break;
+                case Op::Const:
+                    stack.push_back(Interval::point(in.imm));
+                    break;
                 case Op::Load: {
                     const AbstractSlot& s = frame[in.a];
                     if (s.value.isBottom()) return Interval::bottom();  // always unassigned
                     stack.push_back(s.value);
                     break;
                 }
-                case Op::Neg: stack.back() = neg(stack.back()); break;
+                case Op::Neg:
+                    stack.back() = neg(stack.back());
+                    break;
                 case Op::Not: {
                     const Interval v = stack.back();
                     stack.back() = boolean(v.contains(0), v.nan || hasNonZero(v));
@@ -300,18 +348,34 @@ struct IntervalVm {
                     const Interval a = stack.back();
                     Interval r;
                     switch (in.op) {
-                        case Op::Add: r = add(a, b); break;
-                        case Op::Sub: r = sub(a, b); break;
-                        case Op::Mul: r = mul(a, b); break;
-                        case Op::Div: r = div(a, b); break;
-                        case Op::Mod: r = fmodInterval(a, b); break;
-                        case Op::Pow: r = powInterval(a, b); break;
-                        default: r = compare(in.op, a, b); break;
+                        case Op::Add:
+                            r = add(a, b);
+                            break;
+                        case Op::Sub:
+                            r = sub(a, b);
+                            break;
+                        case Op::Mul:
+                            r = mul(a, b);
+                            break;
+                        case Op::Div:
+                            r = div(a, b);
+                            break;
+                        case Op::Mod:
+                            r = fmodInterval(a, b);
+                            break;
+                        case Op::Pow:
+                            r = powInterval(a, b);
+                            break;
+                        default:
+                            r = compare(in.op, a, b);
+                            break;
                     }
                     stack.back() = r;
                     break;
                 }
-                case Op::Jump: pc = in.a; break;
+                case Op::Jump:
+                    pc = in.a;
+                    break;
                 case Op::JumpIfZero: {
                     const Interval v = stack.back();
                     stack.pop_back();
@@ -323,18 +387,23 @@ struct IntervalVm {
                         const Interval y = run(pc, end, stack);
                         return join(x, y);
                     }
-                    if (canJump) pc = in.a;
-                    else if (!canFall) return Interval::bottom();
+                    if (canJump)
+                        pc = in.a;
+                    else if (!canFall)
+                        return Interval::bottom();
                     break;
                 }
                 case Op::Call: {
                     const size_t base = stack.size() - in.argc;
-                    const Interval r = callFunc(static_cast<Func>(in.a), stack.data() + base, in.argc, seed);
+                    const Interval r =
+                        callFunc(static_cast<Func>(in.a), stack.data() + base, in.argc, seed);
                     stack.resize(base);
                     stack.push_back(r);
                     break;
                 }
-                case Op::Rand0: stack.push_back(reals(0, 1)); break;
+                case Op::Rand0:
+                    stack.push_back(reals(0, 1));
+                    break;
                 case Op::Choose: {
                     const size_t base = stack.size() - in.argc;
                     stack.resize(base);
@@ -350,7 +419,9 @@ struct IntervalVm {
 
 // The finite reals of an argument interval (NaN and infinite values are run-time errors
 // in transformations and primitive arguments).
-Interval finiteArg(const Interval& a) { return Interval{a.lo, a.hi, false}; }
+Interval finiteArg(const Interval& a) {
+    return Interval{a.lo, a.hi, false};
+}
 
 }  // namespace
 
@@ -359,7 +430,9 @@ Interval Interval::point(double v) {
     return Interval{v, v, false};
 }
 
-bool Interval::contains(double v) const { return std::isnan(v) ? nan : (lo <= v && v <= hi); }
+bool Interval::contains(double v) const {
+    return std::isnan(v) ? nan : (lo <= v && v <= hi);
+}
 
 Interval join(const Interval& a, const Interval& b) {
     return Interval{std::min(a.lo, b.lo), std::max(a.hi, b.hi), a.nan || b.nan};
@@ -394,7 +467,9 @@ double sinDegrees(double a) {
     if (r == -90 || r == 270) return -1;
     return std::sin(a * kDegToRad);
 }
-double cosDegrees(double a) { return sinDegrees(a + 90.0); }
+double cosDegrees(double a) {
+    return sinDegrees(a + 90.0);
+}
 
 Interval evalInterval(const Graph& g, ExprId e, const AbstractFrame& frame) {
     const Expr& x = g.exprs[e];
@@ -509,9 +584,15 @@ bool transformInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Int
     out = IntervalAffine::of(Affine::identity());
     auto& l = out.l;
     switch (t.op) {
-        case TransformOp::Move: out.t[0] = a[0], out.t[1] = a[1], out.t[2] = a[2]; break;
-        case TransformOp::Scale: l[0][0] = a[0], l[1][1] = a[1], l[2][2] = a[2]; break;
-        case TransformOp::UScale: l[0][0] = l[1][1] = l[2][2] = a[0]; break;
+        case TransformOp::Move:
+            out.t[0] = a[0], out.t[1] = a[1], out.t[2] = a[2];
+            break;
+        case TransformOp::Scale:
+            l[0][0] = a[0], l[1][1] = a[1], l[2][2] = a[2];
+            break;
+        case TransformOp::UScale:
+            l[0][0] = l[1][1] = l[2][2] = a[0];
+            break;
         case TransformOp::RotX:
         case TransformOp::RotY:
         case TransformOp::RotZ: {
@@ -550,10 +631,18 @@ bool transformInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Int
                 for (auto& e : row) e = Interval{std::max(e.lo, -1.0), std::min(e.hi, 1.0), false};
             break;
         }
-        case TransformOp::ZShear: l[2][0] = a[0], l[2][1] = a[1]; break;
-        case TransformOp::FlipYZ: l[0][0] = Interval::point(-1); break;
-        case TransformOp::FlipXZ: l[1][1] = Interval::point(-1); break;
-        case TransformOp::FlipXY: l[2][2] = Interval::point(-1); break;
+        case TransformOp::ZShear:
+            l[2][0] = a[0], l[2][1] = a[1];
+            break;
+        case TransformOp::FlipYZ:
+            l[0][0] = Interval::point(-1);
+            break;
+        case TransformOp::FlipXZ:
+            l[1][1] = Interval::point(-1);
+            break;
+        case TransformOp::FlipXY:
+            l[2][2] = Interval::point(-1);
+            break;
         case TransformOp::Matrix:
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j) l[i][j] = a[3 * j + i];
@@ -583,8 +672,8 @@ Box transformBox(const IntervalAffine& m, const Box& b) {
         double lo = m.t[i].lo, hi = m.t[i].hi;
         for (int j = 0; j < 3; ++j) {
             const Interval& e = m.l[i][j];
-            const double p[4] = {mulEnd(e.lo, b.lo[j]), mulEnd(e.lo, b.hi[j]), mulEnd(e.hi, b.lo[j]),
-                                 mulEnd(e.hi, b.hi[j])};
+            const double p[4] = {mulEnd(e.lo, b.lo[j]), mulEnd(e.lo, b.hi[j]),
+                                 mulEnd(e.hi, b.lo[j]), mulEnd(e.hi, b.hi[j])};
             const double plo = *std::min_element(p, p + 4), phi = *std::max_element(p, p + 4);
             lo = (lo == -kInf || plo == -kInf) ? -kInf : lo + plo;
             hi = (hi == kInf || phi == kInf) ? kInf : hi + phi;

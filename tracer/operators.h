@@ -150,11 +150,15 @@ size_t combineOperands(NodeKind kind, uint32_t count, std::vector<Span>& spans, 
             Span* s = spans.data();
             size_t m = 0;
             switch (kind) {
-                case NodeKind::Union: m = uniteSpans(s + base, acc, s + cbase, n, s + rbase); break;
+                case NodeKind::Union:
+                    m = uniteSpans(s + base, acc, s + cbase, n, s + rbase);
+                    break;
                 case NodeKind::Intersection:
                     m = intersectSpans(s + base, acc, s + cbase, n, s + rbase);
                     break;
-                default: m = subtractSpans(s + base, acc, s + cbase, n, s + rbase); break;
+                default:
+                    m = subtractSpans(s + base, acc, s + cbase, n, s + rbase);
+                    break;
             }
             std::memmove(static_cast<void*>(s + base), s + rbase, m * sizeof(Span));
             acc = m;

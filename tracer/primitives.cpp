@@ -269,7 +269,8 @@ double refineRoot(const double* c, const double* dc, int degree, double a, doubl
         } else {
             b = x;
         }
-        if (b - a <= 4 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(a), std::fabs(b)) ||
+        if (b - a <=
+                4 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(a), std::fabs(b)) ||
             b - a < 1e-300)
             break;
         const double dfx = evalPoly(dc, degree - 1, x);
@@ -327,17 +328,25 @@ int solvePolynomial(const double* coeffs, int degree, double lo, double hi, doub
 int intersectSolid(PrimitiveKind kind, const double* args, const Vec3& o, const Vec3& d,
                    Span out[kMaxPrimitiveSpans]) {
     switch (kind) {
-        case PrimitiveKind::Sphere: return sphere(o, d, out);
-        case PrimitiveKind::Cube: return cube(o, d, out);
-        case PrimitiveKind::Cylinder: return cylinder(o, d, out);
-        case PrimitiveKind::Cone: return cone(o, d, out);
-        case PrimitiveKind::Tetrahedron: return tetrahedron(o, d, out);
-        case PrimitiveKind::Torus: return torus(args, o, d, out);
-        case PrimitiveKind::Plane: return plane(o, d, out);
+        case PrimitiveKind::Sphere:
+            return sphere(o, d, out);
+        case PrimitiveKind::Cube:
+            return cube(o, d, out);
+        case PrimitiveKind::Cylinder:
+            return cylinder(o, d, out);
+        case PrimitiveKind::Cone:
+            return cone(o, d, out);
+        case PrimitiveKind::Tetrahedron:
+            return tetrahedron(o, d, out);
+        case PrimitiveKind::Torus:
+            return torus(args, o, d, out);
+        case PrimitiveKind::Plane:
+            return plane(o, d, out);
         case PrimitiveKind::Empty:
         case PrimitiveKind::Tri1:
         case PrimitiveKind::Tri2:
-        case PrimitiveKind::Triangle: return 0;
+        case PrimitiveKind::Triangle:
+            return 0;
     }
     return 0;
 }
@@ -374,7 +383,8 @@ void triangleCorners(PrimitiveKind kind, const double* args, Vec3 corners[3]) {
             corners[0] = {0, 0, 0}, corners[1] = {-1, 0, 0}, corners[2] = {0, -1, 0};
             return;
         default:
-            for (int i = 0; i < 3; ++i) corners[i] = {args[3 * i], args[3 * i + 1], args[3 * i + 2]};
+            for (int i = 0; i < 3; ++i)
+                corners[i] = {args[3 * i], args[3 * i + 1], args[3 * i + 2]};
             return;
     }
 }
@@ -383,15 +393,19 @@ Box primitiveBox(PrimitiveKind kind, const double* args) {
     switch (kind) {
         case PrimitiveKind::Sphere:
         case PrimitiveKind::Cube:
-        case PrimitiveKind::Tetrahedron: return Box{{-1, -1, -1}, {1, 1, 1}};
+        case PrimitiveKind::Tetrahedron:
+            return Box{{-1, -1, -1}, {1, 1, 1}};
         case PrimitiveKind::Cylinder:
-        case PrimitiveKind::Cone: return Box{{-1, -1, 0}, {1, 1, 1}};
+        case PrimitiveKind::Cone:
+            return Box{{-1, -1, 0}, {1, 1, 1}};
         case PrimitiveKind::Torus: {
             const double e = std::fabs(args[0]) + std::fabs(args[1]), r = std::fabs(args[1]);
             return Box{{-e, -e, -r}, {e, e, r}};
         }
-        case PrimitiveKind::Plane: return Box{{-kInf, -kInf, -kInf}, {kInf, kInf, 0}};
-        case PrimitiveKind::Empty: return Box::empty();
+        case PrimitiveKind::Plane:
+            return Box{{-kInf, -kInf, -kInf}, {kInf, kInf, 0}};
+        case PrimitiveKind::Empty:
+            return Box::empty();
         case PrimitiveKind::Tri1:
         case PrimitiveKind::Tri2:
         case PrimitiveKind::Triangle: {
@@ -407,18 +421,23 @@ Box primitiveBox(PrimitiveKind kind, const double* args) {
 
 bool insideSolid(PrimitiveKind kind, const double* args, const Vec3& p) {
     switch (kind) {
-        case PrimitiveKind::Sphere: return dot(p, p) <= 1;
+        case PrimitiveKind::Sphere:
+            return dot(p, p) <= 1;
         case PrimitiveKind::Cube:
             return std::fabs(p.x) <= 1 && std::fabs(p.y) <= 1 && std::fabs(p.z) <= 1;
-        case PrimitiveKind::Cylinder: return p.x * p.x + p.y * p.y <= 1 && p.z >= 0 && p.z <= 1;
+        case PrimitiveKind::Cylinder:
+            return p.x * p.x + p.y * p.y <= 1 && p.z >= 0 && p.z <= 1;
         case PrimitiveKind::Cone:
             return p.z >= 0 && p.z <= 1 && std::sqrt(p.x * p.x + p.y * p.y) <= 1 - p.z;
         case PrimitiveKind::Tetrahedron:
             return -p.x - p.y - p.z <= 1 && p.x + p.y - p.z <= 1 && -p.x + p.y + p.z <= 1 &&
                    p.x - p.y + p.z <= 1;
-        case PrimitiveKind::Torus: return torusInside(args[0], args[1], p) <= 0;
-        case PrimitiveKind::Plane: return p.z <= 0;
-        default: return false;
+        case PrimitiveKind::Torus:
+            return torusInside(args[0], args[1], p) <= 0;
+        case PrimitiveKind::Plane:
+            return p.z <= 0;
+        default:
+            return false;
     }
 }
 

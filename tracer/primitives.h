@@ -1,4 +1,4 @@
-// Ray intersection with the primitives of LANGUAGE.md section 5, in their own coordinates.
+// Ray intersection with the primitives of docs/language.md section 5, in their own coordinates.
 //
 // The ray is p(t) = origin + t dir with a direction of any length (the tracer never
 // normalises directions in child frames, so that t is the same parameter everywhere in

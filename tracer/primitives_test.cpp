@@ -15,7 +15,9 @@ namespace {
 struct Rng {
     std::mt19937_64 gen;
     explicit Rng(uint64_t seed) : gen(seed) {}
-    double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(gen); }
+    double uniform(double lo, double hi) {
+        return std::uniform_real_distribution<double>(lo, hi)(gen);
+    }
     Vec3 inBox(double r) { return {uniform(-r, r), uniform(-r, r), uniform(-r, r)}; }
     Vec3 unit() {
         for (;;) {
@@ -41,23 +43,27 @@ Affine randomAffine(Rng& rng) {
 // Distance-like residual of the surface at a local point (0 on the surface).
 double surfaceResidual(PrimitiveKind k, const double* args, const Vec3& p) {
     switch (k) {
-        case PrimitiveKind::Sphere: return length(p) - 1;
+        case PrimitiveKind::Sphere:
+            return length(p) - 1;
         case PrimitiveKind::Cube:
             return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) - 1;
         case PrimitiveKind::Cylinder:
             return std::max({std::sqrt(p.x * p.x + p.y * p.y) - 1, -p.z, p.z - 1});
         case PrimitiveKind::Cone:
-            return std::max({(std::sqrt(p.x * p.x + p.y * p.y) - (1 - p.z)) / std::sqrt(2.0), -p.z,
-                             p.z - 1});
+            return std::max(
+                {(std::sqrt(p.x * p.x + p.y * p.y) - (1 - p.z)) / std::sqrt(2.0), -p.z, p.z - 1});
         case PrimitiveKind::Tetrahedron:
-            return std::max({-p.x - p.y - p.z, p.x + p.y - p.z, -p.x + p.y + p.z, p.x - p.y + p.z}) -
+            return std::max(
+                       {-p.x - p.y - p.z, p.x + p.y - p.z, -p.x + p.y + p.z, p.x - p.y + p.z}) -
                    1;
         case PrimitiveKind::Torus: {
             const double rho = std::sqrt(p.x * p.x + p.y * p.y);
             return std::sqrt((rho - args[0]) * (rho - args[0]) + p.z * p.z) - args[1];
         }
-        case PrimitiveKind::Plane: return p.z;
-        default: return 1e9;
+        case PrimitiveKind::Plane:
+            return p.z;
+        default:
+            return 1e9;
     }
 }
 
@@ -130,12 +136,24 @@ void checkPrimitive(PrimitiveKind kind, const double* args, uint64_t seed, int m
     EXPECT_GT(hits, minHits) << "too few rays hit: the test proves little";
 }
 
-TEST(Primitives, Sphere) { checkPrimitive(PrimitiveKind::Sphere, nullptr, 1); }
-TEST(Primitives, Cube) { checkPrimitive(PrimitiveKind::Cube, nullptr, 2); }
-TEST(Primitives, Cylinder) { checkPrimitive(PrimitiveKind::Cylinder, nullptr, 3); }
-TEST(Primitives, Cone) { checkPrimitive(PrimitiveKind::Cone, nullptr, 4); }
-TEST(Primitives, Tetrahedron) { checkPrimitive(PrimitiveKind::Tetrahedron, nullptr, 5); }
-TEST(Primitives, Plane) { checkPrimitive(PrimitiveKind::Plane, nullptr, 6); }
+TEST(Primitives, Sphere) {
+    checkPrimitive(PrimitiveKind::Sphere, nullptr, 1);
+}
+TEST(Primitives, Cube) {
+    checkPrimitive(PrimitiveKind::Cube, nullptr, 2);
+}
+TEST(Primitives, Cylinder) {
+    checkPrimitive(PrimitiveKind::Cylinder, nullptr, 3);
+}
+TEST(Primitives, Cone) {
+    checkPrimitive(PrimitiveKind::Cone, nullptr, 4);
+}
+TEST(Primitives, Tetrahedron) {
+    checkPrimitive(PrimitiveKind::Tetrahedron, nullptr, 5);
+}
+TEST(Primitives, Plane) {
+    checkPrimitive(PrimitiveKind::Plane, nullptr, 6);
+}
 TEST(Primitives, Torus) {
     const double args[2] = {0.8, 0.25};
     checkPrimitive(PrimitiveKind::Torus, args, 7);
@@ -250,8 +268,9 @@ TEST(Primitives, PolynomialRoots) {
 TEST(Primitives, BoxesContainTheSolids) {
     Rng rng(12);
     const double torusArgs[2] = {0.7, 0.3};
-    for (PrimitiveKind k : {PrimitiveKind::Sphere, PrimitiveKind::Cube, PrimitiveKind::Cylinder,
-                            PrimitiveKind::Cone, PrimitiveKind::Tetrahedron, PrimitiveKind::Torus}) {
+    for (PrimitiveKind k :
+         {PrimitiveKind::Sphere, PrimitiveKind::Cube, PrimitiveKind::Cylinder, PrimitiveKind::Cone,
+          PrimitiveKind::Tetrahedron, PrimitiveKind::Torus}) {
         const Box b = primitiveBox(k, torusArgs);
         for (int i = 0; i < 20000; ++i) {
             const Vec3 p = rng.inBox(1.5);

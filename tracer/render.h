@@ -53,9 +53,9 @@ struct RenderResult {
     std::vector<float> rgb;  // linear RGB, row-major from the top-left
     uint64_t rays = 0;
     uint64_t nodeVisits = 0;
-    double seconds = 0;          // the render proper
-    double boundsSeconds = 0;    // computing the hyper-bounding boxes
-    uint32_t infiniteBoxes = 0;  // nodes left with unbounded boxes
+    double seconds = 0;              // the render proper
+    double boundsSeconds = 0;        // computing the hyper-bounding boxes
+    uint32_t infiniteBoxes = 0;      // nodes left with unbounded boxes
     InstanceBoxStats instanceBoxes;  // the instance-box cache at the end
     uint64_t expansions = 0;         // sub-graph instances expanded (all threads)
 };

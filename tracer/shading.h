@@ -1,4 +1,4 @@
-// Lights, materials and background as LANGUAGE.md section 7 says: POV-Ray 3.7.0's classic
+// Lights, materials and background as docs/language.md section 7 says: POV-Ray 3.7.0's classic
 // lighting for the subset of its features the language has, so that `pcsg verify` can
 // compare our image with POV-Ray's pixel by pixel.
 //

@@ -3,7 +3,9 @@
 namespace pcsg::tracer {
 
 namespace {
-Boundary flipped(const Boundary& b) { return Boundary{b.t, -b.normal, b.material}; }
+Boundary flipped(const Boundary& b) {
+    return Boundary{b.t, -b.normal, b.material};
+}
 }  // namespace
 
 size_t uniteSpans(const Span* a, size_t na, const Span* b, size_t nb, Span* out) {

@@ -23,11 +23,13 @@ std::vector<Span> randomList(std::mt19937_64& gen, uint32_t material) {
     for (size_t i = 0; i + 1 < ends.size(); i += 2) {
         if (!(ends[i] < ends[i + 1])) continue;
         if (!out.empty() && out.back().out.t >= ends[i]) continue;  // keep them disjoint
-        out.push_back(Span{Boundary{ends[i], {0, 0, -1}, material}, Boundary{ends[i + 1], {0, 0, 1}, material}});
+        out.push_back(Span{Boundary{ends[i], {0, 0, -1}, material},
+                           Boundary{ends[i + 1], {0, 0, 1}, material}});
     }
     if ((gen() & 7) == 0) {  // an unbounded span now and then
         if (out.empty())
-            out.push_back(Span{Boundary{-INFINITY, {}, material}, Boundary{INFINITY, {}, material}});
+            out.push_back(
+                Span{Boundary{-INFINITY, {}, material}, Boundary{INFINITY, {}, material}});
         else
             out.back().out = Boundary{INFINITY, {}, material};
     }
@@ -49,9 +51,15 @@ std::vector<Span> combine(Op op, const std::vector<Span>& a, const std::vector<S
     std::vector<Span> out(a.size() + b.size() + 1);
     size_t n = 0;
     switch (op) {
-        case Op::Unite: n = uniteSpans(a.data(), a.size(), b.data(), b.size(), out.data()); break;
-        case Op::Intersect: n = intersectSpans(a.data(), a.size(), b.data(), b.size(), out.data()); break;
-        case Op::Subtract: n = subtractSpans(a.data(), a.size(), b.data(), b.size(), out.data()); break;
+        case Op::Unite:
+            n = uniteSpans(a.data(), a.size(), b.data(), b.size(), out.data());
+            break;
+        case Op::Intersect:
+            n = intersectSpans(a.data(), a.size(), b.data(), b.size(), out.data());
+            break;
+        case Op::Subtract:
+            n = subtractSpans(a.data(), a.size(), b.data(), b.size(), out.data());
+            break;
     }
     out.resize(n);
     return out;
@@ -59,9 +67,12 @@ std::vector<Span> combine(Op op, const std::vector<Span>& a, const std::vector<S
 
 bool truth(Op op, bool a, bool b) {
     switch (op) {
-        case Op::Unite: return a || b;
-        case Op::Intersect: return a && b;
-        case Op::Subtract: return a && !b;
+        case Op::Unite:
+            return a || b;
+        case Op::Intersect:
+            return a && b;
+        case Op::Subtract:
+            return a && !b;
     }
     return false;
 }

@@ -50,7 +50,7 @@ struct Instance {
 // Expands the graph (recursively: for small test scenes only). Stops after `limit`
 // instances.
 class Expander {
-public:
+  public:
     explicit Expander(const Graph& g, size_t limit = 200000) : g_(g), limit_(limit) {}
 
     std::vector<Instance> run() {
@@ -60,7 +60,7 @@ public:
         return std::move(out_);
     }
 
-private:
+  private:
     const Graph& g_;
     size_t limit_;
     std::vector<Instance> out_;
@@ -89,7 +89,9 @@ private:
             case NodeKind::Transform:
                 walk(g_.child(n), frame, path, depth, world * transformMatrix(g_, n, st), material);
                 break;
-            case NodeKind::Paint: walk(g_.child(n), frame, path, depth, world, node.payload); break;
+            case NodeKind::Paint:
+                walk(g_.child(n), frame, path, depth, world, node.payload);
+                break;
             case NodeKind::Union:
             case NodeKind::Intersection:
             case NodeKind::Difference:

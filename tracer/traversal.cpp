@@ -203,8 +203,8 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
 // ctx)` traces an expanded instance instead; `transformBack(inv, walkBelow)` runs the
 // walk below a T-node and brings the normals it found back through the T-node.
 template <class Below, class Expanded, class TransformBack>
-auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax,
-                   Below below, Expanded expanded, TransformBack transformBack) {
+auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
+                   Expanded expanded, TransformBack transformBack) {
     using Result = decltype(below(n, r, c));
     const Node& node = g_.nodes[n];
     switch (node.kind) {
@@ -217,7 +217,8 @@ auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 if (selectCulled(n, r, c, depth, tmin, tmax)) return Result{};
                 if (const ExpandedInstance* x = expandedAt(n, c, depth)) return expanded(*x, c);
                 const uint32_t rule = selectRule(g_, n, st);
-                return below(g_.child(n, rule), r, Ctx{c.frame, pathRule(c.path, rule), depth, c.material});
+                return below(g_.child(n, rule), r,
+                             Ctx{c.frame, pathRule(c.path, rule), depth, c.material});
             } catch (RuntimeError& e) {
                 e.enterModule(g_.modules[node.payload].name);
                 throw;
@@ -244,12 +245,12 @@ auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
         }
         case NodeKind::Paint:
             return below(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload});
-        default: return Result{};  // not a unary node
+        default:
+            return Result{};  // not a unary node
     }
 }
 
-bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
-                   Hit& hit) {
+bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit) {
     ++visits_;
     const Node& node = g_.nodes[n];
     switch (node.kind) {

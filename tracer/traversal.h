@@ -42,11 +42,11 @@
 #include <vector>
 
 #include "bounds.h"
+#include "eval.h"
 #include "expanded_instances.h"
+#include "graph.h"
 #include "instance_boxes.h"
 #include "operators.h"
-#include "eval.h"
-#include "graph.h"
 #include "primitives.h"
 
 namespace pcsg::tracer {
@@ -119,7 +119,9 @@ class Tracer {
     bool anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tmax);
 
     // Node visits, of the graph and of expanded instances.
-    uint64_t nodeVisits() const { return visits_ + (expansion_ ? expansion_->scratch().visits : 0); }
+    uint64_t nodeVisits() const {
+        return visits_ + (expansion_ ? expansion_->scratch().visits : 0);
+    }
     // Instances this tracer expanded, and what its cache of them holds now.
     uint64_t expansions() const { return expansion_ ? expansion_->expansions() : 0; }
     size_t expansionCacheBytes() const { return expansion_ ? expansion_->bytes() : 0; }
@@ -156,8 +158,8 @@ class Tracer {
                       double tmax);
     const ExpandedInstance* expandedAt(NodeId n, const Ctx& c, uint32_t depth);
     template <class Below, class Expanded, class TransformBack>
-    auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax,
-               Below below, Expanded expanded, TransformBack transformBack);
+    auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
+               Expanded expanded, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
     void checkStack();
 

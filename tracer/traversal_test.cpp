@@ -21,7 +21,6 @@
 #include "traversal.h"
 
 #include <gtest/gtest.h>
-#include "sanitizer.h"
 
 #include <algorithm>
 #include <array>
@@ -35,6 +34,7 @@
 
 #include "bounds.h"
 #include "primitives.h"
+#include "sanitizer.h"
 #include "test_support.h"
 
 namespace pcsg::tracer {

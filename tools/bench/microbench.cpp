@@ -175,8 +175,8 @@ void firstHitBench(benchmark::State& state, bool instanceBoxes) {
         i = (i + 1) % camRays.size();
     }
     state.SetItemsProcessed(state.iterations());
-    state.counters["visits/ray"] = benchmark::Counter(
-        static_cast<double>(tracer.nodeVisits()) / static_cast<double>(state.iterations()));
+    state.counters["visits/ray"] = benchmark::Counter(static_cast<double>(tracer.nodeVisits()) /
+                                                      static_cast<double>(state.iterations()));
 }
 BENCHMARK_CAPTURE(firstHitBench, sierpinski8_static_boxes, false);
 BENCHMARK_CAPTURE(firstHitBench, sierpinski8_instance_boxes, true);
