@@ -52,19 +52,18 @@ struct ChainItem {
 // CSG expressions (section 5).
 
 enum class CsgKind : uint8_t {
-    Union,
-    Intersection,
-    Difference,  // operands [first, first+count) of Ast::lists
-    Transform,   // `op` on `child`; its arguments [first, first+count) of Ast::lists (ExNodes)
-    Calc,        // a C-node { ... } on `child`; assignments [first, first+count) of Ast::assigns
-    Paint,       // paint(name) on `child`; the material's name at `nameTok`
-    Primitive,   // `prim`; arguments [first, first+count) of Ast::lists (ExNodes)
-    Name,        // a module or definition name at `nameTok`
-    Call,        // a notation-B call `S(e1, ...)`: S at `nameTok`, arguments as for Transform
+    Operator,   // `csgOp` on operands [first, first+count) of Ast::lists
+    Transform,  // `op` on `child`; its arguments [first, first+count) of Ast::lists (ExNodes)
+    Calc,       // a C-node { ... } on `child`; assignments [first, first+count) of Ast::assigns
+    Paint,      // paint(name) on `child`; the material's name at `nameTok`
+    Primitive,  // `prim`; arguments [first, first+count) of Ast::lists (ExNodes)
+    Name,       // a module or definition name at `nameTok`
+    Call,       // a notation-B call `S(e1, ...)`: S at `nameTok`, arguments as for Transform
 };
 
 struct CsgNode {
     CsgKind kind;
+    CsgOp csgOp = CsgOp::Union;  // Operator
     TransformOp op = TransformOp::Move;
     PrimitiveKind prim = PrimitiveKind::Empty;
     uint32_t tok = 0;      // the first token (for operators: the first operator token)

@@ -595,9 +595,7 @@ class Builder {
     void namedDefinitions(uint32_t c, std::vector<uint32_t>& out) const {
         const CsgNode& n = ast_.csg[c];
         switch (n.kind) {
-            case CsgKind::Union:
-            case CsgKind::Intersection:
-            case CsgKind::Difference:
+            case CsgKind::Operator:
                 for (uint32_t i = 0; i < n.count; ++i)
                     namedDefinitions(ast_.lists[n.first + i], out);
                 break;
@@ -749,17 +747,12 @@ class Builder {
         const CsgNode& n = ast_.csg[c];
         const FileLoc where = loc(n.tok);
         switch (n.kind) {
-            case CsgKind::Union:
-            case CsgKind::Intersection:
-            case CsgKind::Difference: {
+            case CsgKind::Operator: {
                 std::vector<NodeId> children;
                 children.reserve(n.count);
                 for (uint32_t i = 0; i < n.count; ++i)
                     children.push_back(csg(ast_.lists[n.first + i]));
-                const NodeKind kind = n.kind == CsgKind::Union          ? NodeKind::Union
-                                      : n.kind == CsgKind::Intersection ? NodeKind::Intersection
-                                                                        : NodeKind::Difference;
-                return g_.addNode(kind, kNone, children, where);
+                return g_.addOperator(n.csgOp, children, where);
             }
             case CsgKind::Transform:
                 return transform(n);
@@ -1220,18 +1213,17 @@ class Builder {
         }
         for (NodeId i = 0; i < count; ++i) {
             const Node& n = g_.nodes[i];
-            if (n.kind != NodeKind::Intersection && n.kind != NodeKind::Difference) continue;
+            if (n.kind != NodeKind::Operator || n.op() == CsgOp::Union) continue;
             for (uint32_t k = 0; k < n.childCount; ++k) {
                 const NodeId c = g_.child(i, k);
                 if (c >= count || source[c] == kNone) continue;
                 const Node& tri = g_.nodes[source[c]];
                 diags_.error(
-                    n.loc,
-                    fmt::format("a triangle ({} at line {}) is reachable as an operand of "
-                                "this {}: triangles are surfaces without an inside, "
-                                "so only '∪' may combine them",
-                                primitiveName(g_.primitives[tri.payload].kind), tri.loc.line,
-                                n.kind == NodeKind::Intersection ? "intersection" : "difference"));
+                    n.loc, fmt::format("a triangle ({} at line {}) is reachable as an operand of "
+                                       "this {}: triangles are surfaces without an inside, "
+                                       "so only '∪' may combine them",
+                                       primitiveName(g_.primitives[tri.payload].kind), tri.loc.line,
+                                       csgOpName(n.op())));
                 break;
             }
         }

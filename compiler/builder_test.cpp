@@ -56,9 +56,7 @@ void walk(const Graph& g, NodeId n, const std::vector<double>& frame, uint64_t p
         case NodeKind::Paint:
             walk(g, g.child(n), frame, path, depth, world, node.payload, out);
             return;
-        case NodeKind::Union:
-        case NodeKind::Intersection:
-        case NodeKind::Difference:
+        case NodeKind::Operator:
             for (uint32_t i = 0; i < node.childCount; ++i)
                 walk(g, g.child(n, i), frame, pathChild(path, i), depth, world, material, out);
             return;
@@ -203,14 +201,14 @@ TEST(Figures, Figure5aWithTheLeafOfFigure6) {
     EXPECT_EQ(g.nodes[g.modules[1].node].childCount, 3u);
     // `leaf` is built once and shared by both of its uses in `segment`.
     const NodeId seg = g.child(g.modules[1].node, 1);  // rule 2: segment
-    ASSERT_EQ(g.nodes[seg].kind, NodeKind::Union);
+    ASSERT_TRUE(g.nodes[seg].is(CsgOp::Union));
     const NodeId moved = g.child(seg, 1);
     const NodeId pair = g.child(moved);
-    ASSERT_EQ(g.nodes[pair].kind, NodeKind::Union);
+    ASSERT_TRUE(g.nodes[pair].is(CsgOp::Union));
     const NodeId leaf1 = g.child(g.child(pair, 0));
     const NodeId leaf2 = g.child(g.child(g.child(pair, 1)));
     EXPECT_EQ(leaf1, leaf2);
-    EXPECT_EQ(g.nodes[leaf1].kind, NodeKind::Intersection);
+    EXPECT_TRUE(g.nodes[leaf1].is(CsgOp::Intersection));
     // It unrolls: trunk of 3 segments, then a binary tree of order 4; every leaf reached.
     const auto ls = leaves(g);
     EXPECT_GT(ls.size(), 100u);

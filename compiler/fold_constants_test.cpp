@@ -114,7 +114,7 @@ struct FlatSink {
         return 0;
     }
     void beginOperator(WalkEntry&) {}
-    int endOperator(TreeKind, const int*, uint32_t, const WalkEntry&) { return 0; }
+    int endOperator(CsgOp, const int*, uint32_t, const WalkEntry&) { return 0; }
 };
 
 Flat flatten(const Graph& g) {

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "csg_op.h"
+
 namespace pcsg {
 
 struct Vec3 {
@@ -199,6 +201,18 @@ constexpr Box intersect(const Box& a, const Box& b) {
 // The box of an affine image of a box (Arvo's method): tight for the image of the
 // box itself, and correct for infinite extents as long as no 0 * inf arises
 // (zero factors contribute nothing).
+// The box of what a CSG operator holds, from its operands' boxes `boxOf(i)`: a union's box
+// holds them all, an intersection's is their common part, a difference's its first
+// operand's.
+template <class BoxOf>
+Box csgBox(CsgOp op, uint32_t count, BoxOf boxOf) {
+    if (op == CsgOp::Difference) return count ? boxOf(0) : Box::empty();
+    Box b = op == CsgOp::Union ? Box::empty() : Box::everything();
+    for (uint32_t i = 0; i < count; ++i)
+        b = op == CsgOp::Union ? unite(b, boxOf(i)) : intersect(b, boxOf(i));
+    return b.isEmpty() ? Box::empty() : b;
+}
+
 inline Box transformBox(const Affine& m, const Box& b) {
     if (b.isEmpty()) return b;
     Box r;

@@ -12,7 +12,7 @@
 //    expressions over parameter slots.
 //  - C-nodes (Calc) have one child and an ordered list of assignments.
 //  - Paint nodes have one child and a material index.
-//  - Union, Intersection and Difference are n-ary (chains of the same operator are
+//  - Operator nodes (∪ ∩ \, their CsgOp in the payload) are n-ary (chains of the same operator are
 //    flattened by the builder: A ∪ B ∪ C is one Union with three children;
 //    A \ B \ C is one Difference: the first child minus all the others).
 //  - Primitive nodes are leaves.
@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "csg_op.h"
 #include "geometry.h"
 
 namespace pcsg {
@@ -114,19 +115,20 @@ enum class NodeKind : uint8_t {
     Transform,
     Calc,
     Paint,
-    Union,
-    Intersection,
-    Difference,
+    Operator,  // ∪ ∩ \: the CsgOp is the payload
     Primitive,
 };
 
 struct Node {
     NodeKind kind;
     uint32_t payload = kNone;  // index into the kind's table (modules, transforms, calcs,
-                               // materials for Paint, primitives); unused for operators
+                               // materials for Paint, primitives); the CsgOp of an Operator
     uint32_t firstChild = 0;   // children are Graph::edges[firstChild, firstChild+childCount)
     uint32_t childCount = 0;
     FileLoc loc;
+
+    CsgOp op() const { return static_cast<CsgOp>(payload); }  // Operator nodes
+    bool is(CsgOp o) const { return kind == NodeKind::Operator && op() == o; }
 };
 
 // One module: the data of its S-node.
@@ -265,6 +267,9 @@ struct Graph {
     // --- construction helpers (used by the builder and by tests) ---
     NodeId addNode(NodeKind kind, uint32_t payload, const std::vector<NodeId>& children,
                    FileLoc loc = {});
+    NodeId addOperator(CsgOp op, const std::vector<NodeId>& children, FileLoc loc = {}) {
+        return addNode(NodeKind::Operator, static_cast<uint32_t>(op), children, loc);
+    }
     ExprId addConstant(double value, FileLoc loc = {});
     ExprId addLoad(Slot slot, FileLoc loc = {});
     Slot slot(const std::string& name);  // finds or creates the slot for a name

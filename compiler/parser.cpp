@@ -438,9 +438,10 @@ class Parser {
         ast_.csg.push_back(n);
         return static_cast<uint32_t>(ast_.csg.size() - 1);
     }
-    uint32_t addOperator(CsgKind kind, uint32_t opTok, const std::vector<uint32_t>& operands) {
+    uint32_t addOperator(CsgOp op, uint32_t opTok, const std::vector<uint32_t>& operands) {
         CsgNode n;
-        n.kind = kind;
+        n.kind = CsgKind::Operator;
+        n.csgOp = op;
         n.tok = opTok;
         n.first = static_cast<uint32_t>(ast_.lists.size());
         n.count = static_cast<uint32_t>(operands.size());
@@ -458,7 +459,7 @@ class Parser {
             ++p_;
             operands.push_back(term());
         }
-        return addOperator(CsgKind::Union, opTok, operands);
+        return addOperator(CsgOp::Union, opTok, operands);
     }
 
     // term -> unary { (INTERSECT | DIFFERENCE) unary }     (left-associative; a run of
@@ -466,10 +467,10 @@ class Parser {
     uint32_t term() {
         uint32_t left = unary();
         std::vector<uint32_t> operands;
-        CsgKind kind = CsgKind::Union;  // Union: no run yet
+        CsgOp kind = CsgOp::Union;  // Union: no run yet
         uint32_t opTok = 0;
         while (at(Tok::Intersect) || at(Tok::Difference)) {
-            const CsgKind k = at(Tok::Intersect) ? CsgKind::Intersection : CsgKind::Difference;
+            const CsgOp k = at(Tok::Intersect) ? CsgOp::Intersection : CsgOp::Difference;
             const uint32_t here = pos();
             ++p_;
             const uint32_t right = unary();
@@ -477,12 +478,12 @@ class Parser {
                 operands.push_back(right);
                 continue;
             }
-            if (kind != CsgKind::Union) left = addOperator(kind, opTok, operands);
+            if (kind != CsgOp::Union) left = addOperator(kind, opTok, operands);
             operands = {left, right};
             kind = k;
             opTok = here;
         }
-        if (kind != CsgKind::Union) left = addOperator(kind, opTok, operands);
+        if (kind != CsgOp::Union) left = addOperator(kind, opTok, operands);
         return left;
     }
 

@@ -43,12 +43,8 @@ std::string shape(const Graph& g, NodeId n) {
             return "C" + shape(g, g.child(n));
         case NodeKind::Paint:
             return "P" + shape(g, g.child(n));
-        case NodeKind::Union:
-            return kids("U");
-        case NodeKind::Intersection:
-            return kids("I");
-        case NodeKind::Difference:
-            return kids("D");
+        case NodeKind::Operator:
+            return kids(node.is(CsgOp::Union) ? "U" : node.is(CsgOp::Intersection) ? "I" : "D");
         case NodeKind::Primitive: {
             static const char* names[] = {"sphere",      "cube",  "cylinder", "cone",
                                           "tetrahedron", "torus", "plane",    "empty",

@@ -19,7 +19,7 @@
 //   Result primitive(PrimitiveKind, const Affine& world, uint32_t material,
 //                    const double* args, uint32_t argc);
 //   void beginOperator(WalkEntry&);
-//   Result endOperator(TreeKind, const Result* operands, uint32_t n, const WalkEntry&);
+//   Result endOperator(CsgOp, const Result* operands, uint32_t n, const WalkEntry&);
 // and optionally, to see every S-node instance in its own frame:
 //   static constexpr bool kLocalSelectFrames = true;
 //   Result toParent(const Affine& selectToParent, const Result& local);
@@ -36,8 +36,6 @@
 #include "graph.h"
 
 namespace pcsg {
-
-enum class TreeKind : uint8_t { Primitive, Union, Intersection, Difference };
 
 // The argument values a primitive kind carries into an expanded tree.
 constexpr uint32_t storedArgs(PrimitiveKind k) {
@@ -219,9 +217,7 @@ class Walker {
                 }
                 return;
             }
-            case NodeKind::Union:
-            case NodeKind::Intersection:
-            case NodeKind::Difference: {
+            case NodeKind::Operator: {
                 if (e.next == 0) {
                     sink_.visit();
                     e.resultBase = results_.size();
@@ -236,12 +232,10 @@ class Walker {
                     stack_.push_back(c);
                     return;
                 }
-                const TreeKind kind = node.kind == NodeKind::Union          ? TreeKind::Union
-                                      : node.kind == NodeKind::Intersection ? TreeKind::Intersection
-                                                                            : TreeKind::Difference;
                 const size_t base = e.resultBase;
-                const Result r = sink_.endOperator(
-                    kind, results_.data() + base, static_cast<uint32_t>(results_.size() - base), e);
+                const Result r =
+                    sink_.endOperator(node.op(), results_.data() + base,
+                                      static_cast<uint32_t>(results_.size() - base), e);
                 results_.resize(base);
                 results_.push_back(r);
                 stack_.pop_back();

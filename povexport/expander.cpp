@@ -124,14 +124,10 @@ class CountSink {
 
     void beginOperator(WalkEntry&) {}
 
-    Count endOperator(TreeKind kind, const Count* r, uint32_t n, const WalkEntry&) {
+    Count endOperator(CsgOp op, const Count* r, uint32_t n, const WalkEntry&) {
         Count sum;
         uint32_t kept = 0;
-        if (kind == TreeKind::Intersection) {
-            for (uint32_t i = 0; i < n; ++i)
-                if (r[i].empty) return Count{};
-        }
-        if (kind == TreeKind::Difference && (n == 0 || r[0].empty)) return Count{};
+        if (csgHoldsNothing(op, n, [&](uint32_t i) { return r[i].empty; })) return Count{};
         for (uint32_t i = 0; i < n; ++i) {
             if (r[i].empty) continue;
             sum = plus(sum, r[i]);
@@ -196,7 +192,7 @@ class TreeSink {
             p.firstArg = static_cast<uint32_t>(t_.args.size());
             t_.args.insert(t_.args.end(), args, args + argc);
         }
-        t_.nodes.push_back({TreeKind::Primitive, static_cast<uint32_t>(t_.primitives.size()), 0});
+        t_.nodes.push_back({true, CsgOp::Union, static_cast<uint32_t>(t_.primitives.size()), 0});
         t_.primitives.push_back(p);
         return static_cast<uint32_t>(t_.nodes.size() - 1);
     }
@@ -208,22 +204,17 @@ class TreeSink {
         e.mark[3] = t_.args.size();
     }
 
-    Result endOperator(TreeKind kind, const uint32_t* r, uint32_t n, const WalkEntry& e) {
-        if (kind == TreeKind::Intersection) {
-            for (uint32_t i = 0; i < n; ++i)
-                if (r[i] == kNone) return discard(e);
-        }
-        if (kind == TreeKind::Difference && (n == 0 || r[0] == kNone)) return discard(e);
+    Result endOperator(CsgOp op, const uint32_t* r, uint32_t n, const WalkEntry& e) {
+        if (csgHoldsNothing(op, n, [&](uint32_t i) { return r[i] == kNone; })) return discard(e);
         uint32_t kept = 0, last = kNone;
         for (uint32_t i = 0; i < n; ++i)
             if (r[i] != kNone) ++kept, last = r[i];
-        if (kept == 0) return kNone;
-        if (kept == 1) return kind == TreeKind::Difference ? r[0] : last;
+        if (kept == 1) return op == CsgOp::Difference ? r[0] : last;
         reserveNode();
         const uint32_t first = static_cast<uint32_t>(t_.children.size());
         for (uint32_t i = 0; i < n; ++i)
             if (r[i] != kNone) t_.children.push_back(r[i]);
-        t_.nodes.push_back({kind, first, kept});
+        t_.nodes.push_back({false, op, first, kept});
         return static_cast<uint32_t>(t_.nodes.size() - 1);
     }
 

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "graph.h"
-#include "walk.h"  // TreeKind
+#include "walk.h"
 
 namespace pcsg {
 
@@ -30,9 +30,12 @@ struct TreePrimitive {
 };
 
 struct TreeNode {
-    TreeKind kind;
-    uint32_t first = 0;  // Primitive: index into primitives; operators: into children
+    bool primitive = false;  // a primitive, else an operator
+    CsgOp op = CsgOp::Union;
+    uint32_t first = 0;  // primitives: index into primitives; operators: into children
     uint32_t count = 0;  // operators: the number of children (at least 2)
+
+    bool is(CsgOp o) const { return !primitive && op == o; }
 };
 
 // A finite CSG tree in flat arrays. Nodes are stored in post-order: every node's

@@ -59,7 +59,7 @@ TEST(Expander, SierpinskiCornersAreTheTetrahedronsVertices) {
     EXPECT_EQ(centres, expected);
     // The union keeps its four operands in the graph's order.
     const TreeNode& root = t.nodes[t.root];
-    EXPECT_EQ(root.kind, TreeKind::Union);
+    EXPECT_TRUE(root.is(CsgOp::Union));
     ASSERT_EQ(root.count, 4u);
     EXPECT_EQ(t.primitiveOf(t.childrenOf(t.root)[0]).toWorld.t, Vec3(0.5, 0.5, 0.5));
     EXPECT_EQ(t.primitiveOf(t.childrenOf(t.root)[3]).toWorld.t, Vec3(-0.5, 0.5, -0.5));
@@ -163,7 +163,7 @@ TEST(Expander, RuntimeErrorsCarryTheModulePath) {
     const NodeId t = module(g, "T", g.addConstant(1), 1);
     setRule(g, s, 0, primitive(g, PrimitiveKind::Sphere));
     setRule(g, s, 1, transform(g, TransformOp::UScale, {0.5}, s));
-    setRule(g, t, 0, g.addNode(NodeKind::Union, kNone, {primitive(g, PrimitiveKind::Cube), s}));
+    setRule(g, t, 0, g.addOperator(CsgOp::Union, {primitive(g, PrimitiveKind::Cube), s}));
     g.axiom = calc(g, {{c, g.addConstant(1)}}, t);
     for (int pass = 0; pass < 2; ++pass) {
         try {
@@ -229,7 +229,7 @@ TEST(Expander, SiblingsDoNotSeeEachOthersAssignments) {
     const NodeId b =
         transformOf(g, TransformOp::Move, {g.addLoad(c), g.addConstant(0), g.addConstant(0)},
                     primitive(g, PrimitiveKind::Cube));
-    g.axiom = calc(g, {{c, g.addConstant(1)}}, g.addNode(NodeKind::Union, kNone, {a, b}));
+    g.axiom = calc(g, {{c, g.addConstant(1)}}, g.addOperator(CsgOp::Union, {a, b}));
     const ExpandedTree t = expand(g);
     ASSERT_EQ(t.primitives.size(), 2u);
     EXPECT_EQ(t.primitives[0].toWorld.t.x, 5.0);
@@ -239,20 +239,20 @@ TEST(Expander, SiblingsDoNotSeeEachOthersAssignments) {
 TEST(Expander, EmptyFoldsAwayAndCountsAgree) {
     struct Case {
         const char* name;
-        NodeKind kind;
+        CsgOp op;
         std::vector<PrimitiveKind> operands;
         size_t prims, nodes;
     };
     using P = PrimitiveKind;
     const std::vector<Case> cases = {
-        {"sphere ∪ empty", NodeKind::Union, {P::Sphere, P::Empty}, 1, 1},
-        {"empty ∪ empty", NodeKind::Union, {P::Empty, P::Empty}, 0, 0},
-        {"sphere ∪ empty ∪ cube", NodeKind::Union, {P::Sphere, P::Empty, P::Cube}, 2, 3},
-        {"sphere ∩ cube ∩ empty", NodeKind::Intersection, {P::Sphere, P::Cube, P::Empty}, 0, 0},
-        {"sphere ∩ cube", NodeKind::Intersection, {P::Sphere, P::Cube}, 2, 3},
-        {"sphere \\ empty", NodeKind::Difference, {P::Sphere, P::Empty}, 1, 1},
-        {"sphere \\ empty \\ cube", NodeKind::Difference, {P::Sphere, P::Empty, P::Cube}, 2, 3},
-        {"empty \\ sphere", NodeKind::Difference, {P::Empty, P::Sphere}, 0, 0},
+        {"sphere ∪ empty", CsgOp::Union, {P::Sphere, P::Empty}, 1, 1},
+        {"empty ∪ empty", CsgOp::Union, {P::Empty, P::Empty}, 0, 0},
+        {"sphere ∪ empty ∪ cube", CsgOp::Union, {P::Sphere, P::Empty, P::Cube}, 2, 3},
+        {"sphere ∩ cube ∩ empty", CsgOp::Intersection, {P::Sphere, P::Cube, P::Empty}, 0, 0},
+        {"sphere ∩ cube", CsgOp::Intersection, {P::Sphere, P::Cube}, 2, 3},
+        {"sphere \\ empty", CsgOp::Difference, {P::Sphere, P::Empty}, 1, 1},
+        {"sphere \\ empty \\ cube", CsgOp::Difference, {P::Sphere, P::Empty, P::Cube}, 2, 3},
+        {"empty \\ sphere", CsgOp::Difference, {P::Empty, P::Sphere}, 0, 0},
     };
     for (const Case& k : cases) {
         Graph g;
@@ -260,8 +260,8 @@ TEST(Expander, EmptyFoldsAwayAndCountsAgree) {
         std::vector<NodeId> ops;
         for (P p : k.operands) ops.push_back(primitive(g, p));
         // Wrapped in a union with a torus, so that discarded operands must leave no trace.
-        const NodeId inner = g.addNode(k.kind, kNone, ops);
-        g.axiom = g.addNode(NodeKind::Union, kNone, {inner, primitive(g, P::Torus, {2, 0.5})});
+        const NodeId inner = g.addOperator(k.op, ops);
+        g.axiom = g.addOperator(CsgOp::Union, {inner, primitive(g, P::Torus, {2, 0.5})});
         const ExpandedTree t = expand(g);
         const size_t outer =
             k.prims > 0 ? 1 : 0;  // the outer union survives only with two operands
@@ -292,10 +292,9 @@ TEST(Expander, TorusAndTriangleArgumentsAreEvaluatedPerInstance) {
     std::vector<ExprId> tri;
     for (double v : {0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}) tri.push_back(g.addConstant(v));
     tri.push_back(g.addLoad(r));
-    const NodeId u =
-        g.addNode(NodeKind::Union, kNone,
-                  {primitiveOf(g, PrimitiveKind::Torus, {g.addConstant(1), g.addLoad(r)}),
-                   primitiveOf(g, PrimitiveKind::Triangle, tri)});
+    const NodeId u = g.addOperator(
+        CsgOp::Union, {primitiveOf(g, PrimitiveKind::Torus, {g.addConstant(1), g.addLoad(r)}),
+                       primitiveOf(g, PrimitiveKind::Triangle, tri)});
     g.axiom = calc(g, {{r, g.addConstant(0.25)}}, u);
     const ExpandedTree t = expand(g);
     ASSERT_EQ(t.primitives.size(), 2u);
@@ -311,7 +310,7 @@ TEST(Expander, DeepGraphsNeedNoDeepCStack) {
     NodeId n = primitive(g, PrimitiveKind::Sphere);
     for (int i = 0; i < 50000; ++i) n = transform(g, TransformOp::Move, {1e-6, 0, 0}, n);
     for (int i = 0; i < 50000; ++i)
-        n = g.addNode(NodeKind::Union, kNone, {n, primitive(g, PrimitiveKind::Cube)});
+        n = g.addOperator(CsgOp::Union, {n, primitive(g, PrimitiveKind::Cube)});
     g.axiom = n;
     const ExpandedTree t = expand(g);
     EXPECT_EQ(t.primitives.size(), 50001u);

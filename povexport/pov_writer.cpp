@@ -118,27 +118,9 @@ std::vector<Box> nodeBoxes(const ExpandedTree& t) {
     std::vector<Box> boxes(t.nodes.size());
     for (uint32_t n = 0; n < t.nodes.size(); ++n) {
         const TreeNode& node = t.nodes[n];
-        switch (node.kind) {
-            case TreeKind::Primitive:
-                boxes[n] = primitiveBox(t, t.primitiveOf(n));
-                break;
-            case TreeKind::Union: {
-                Box b;
-                for (uint32_t i = 0; i < node.count; ++i) b.extend(boxes[t.childrenOf(n)[i]]);
-                boxes[n] = b;
-                break;
-            }
-            case TreeKind::Intersection: {
-                Box b = Box::everything();
-                for (uint32_t i = 0; i < node.count; ++i)
-                    b = intersect(b, boxes[t.childrenOf(n)[i]]);
-                boxes[n] = b;
-                break;
-            }
-            case TreeKind::Difference:
-                boxes[n] = boxes[t.childrenOf(n)[0]];
-                break;
-        }
+        boxes[n] = node.primitive ? primitiveBox(t, t.primitiveOf(n))
+                                  : csgBox(node.op, node.count,
+                                           [&](uint32_t i) { return boxes[t.childrenOf(n)[i]]; });
     }
     return boxes;
 }
@@ -415,7 +397,7 @@ class TreeWriter {
         Item& it = stack_.back();
         if (!it.group) {
             const TreeNode& node = t_.nodes[it.node];
-            if (node.kind == TreeKind::Primitive) {
+            if (node.primitive) {
                 if (putPrimitive(o_, t_, t_.primitiveOf(it.node), indent()))
                     ++stats_.objects;
                 else
@@ -424,8 +406,7 @@ class TreeWriter {
                 return;
             }
             const bool deep = stack_.size() > kMaxNesting;
-            if (node.kind == TreeKind::Union && it.next == 0 &&
-                (node.count > maxChildren_ || deep)) {
+            if (node.is(CsgOp::Union) && it.next == 0 && (node.count > maxChildren_ || deep)) {
                 // Regroup: the operands become a group item over a run of `members`. Deep
                 // in the tree (a long chain of unions from a linear recursion), the
                 // union's whole union-subtree is flattened first: POV-Ray's parser
@@ -447,10 +428,7 @@ class TreeWriter {
                 return;
             }
             if (it.next == 0) {
-                const char* name = node.kind == TreeKind::Union          ? "union"
-                                   : node.kind == TreeKind::Intersection ? "intersection"
-                                                                         : "difference";
-                o_.put("{}{} {{\n", indent(), name);
+                o_.put("{}{} {{\n", indent(), csgOpName(node.op));
             }
             if (it.next < node.count) {
                 const uint32_t c = t_.childrenOf(it.node)[it.next++];
@@ -458,7 +436,7 @@ class TreeWriter {
                 return;
             }
             const Box& b = boxes_[it.node];
-            const bool bound = node.kind != TreeKind::Union || opt_.boundUnions;
+            const bool bound = !node.is(CsgOp::Union) || opt_.boundUnions;
             o_.put("{}", indent());
             if (bound && boundable(b)) putBound(o_, b);
             o_.put(" }}\n");
@@ -508,7 +486,7 @@ class TreeWriter {
             todo.pop_back();
             const uint32_t* c = t_.childrenOf(u);
             for (uint32_t i = 0; i < t_.nodes[u].count; ++i) {
-                if (t_.nodes[c[i]].kind == TreeKind::Union)
+                if (t_.nodes[c[i]].is(CsgOp::Union))
                     todo.push_back(c[i]);
                 else
                     members_.push_back(c[i]);

@@ -94,7 +94,7 @@ TEST(PovWriter, EachMaterialIsDeclaredOnceAsATexture) {
         parts.push_back(paint(
             g, 1, transform(g, TransformOp::Move, {double(i), 0, 0}, primitive(g, P::Sphere))));
     parts.push_back(primitive(g, P::Cube));
-    g.axiom = g.addNode(NodeKind::Union, kNone, parts);
+    g.axiom = g.addOperator(CsgOp::Union, parts);
     const std::string s = exportText(g);
     EXPECT_EQ(occurrences(s, "#declare M1 = texture"), 1u);
     EXPECT_NE(s.find("#declare M0 = texture { pigment { color rgb <1,1,1> } finish { ambient 0.1 "
@@ -151,9 +151,8 @@ TEST(PovWriter, PrimitivesInPovRaysOwnFormWithTheTransposedMatrix) {
 TEST(PovWriter, DegenerateTrianglesAndEmptyAreLeftOut) {
     Graph g;
     defaultScene(g);
-    g.axiom = g.addNode(NodeKind::Union, kNone,
-                        {primitive(g, P::Triangle, {0, 0, 0, 1, 1, 1, 2, 2, 2}),
-                         primitive(g, P::Empty), primitive(g, P::Tri1)});
+    g.axiom = g.addOperator(CsgOp::Union, {primitive(g, P::Triangle, {0, 0, 0, 1, 1, 1, 2, 2, 2}),
+                                           primitive(g, P::Empty), primitive(g, P::Tri1)});
     const ExpandedTree t = expand(g);
     std::ostringstream os;
     const PovWriteStats st = writePov(g, t, os);
@@ -168,13 +167,13 @@ TEST(PovWriter, IntersectionsAndDifferencesAreBounded) {
     Graph g;
     defaultScene(g);
     const NodeId a =
-        g.addNode(NodeKind::Intersection, kNone, {primitive(g, P::Plane), primitive(g, P::Sphere)});
-    const NodeId b = g.addNode(NodeKind::Difference, kNone,
-                               {primitive(g, P::Cube), transform(g, TransformOp::Move, {0, 0, 1},
-                                                                 primitive(g, P::Sphere))});
-    g.axiom = transform(
-        g, TransformOp::Move, {10, 0, 0},
-        g.addNode(NodeKind::Union, kNone, {a, transform(g, TransformOp::Move, {0, 5, 0}, b)}));
+        g.addOperator(CsgOp::Intersection, {primitive(g, P::Plane), primitive(g, P::Sphere)});
+    const NodeId b = g.addOperator(
+        CsgOp::Difference, {primitive(g, P::Cube),
+                            transform(g, TransformOp::Move, {0, 0, 1}, primitive(g, P::Sphere))});
+    g.axiom =
+        transform(g, TransformOp::Move, {10, 0, 0},
+                  g.addOperator(CsgOp::Union, {a, transform(g, TransformOp::Move, {0, 5, 0}, b)}));
     const std::string s = exportText(g);
     EXPECT_EQ(occurrences(s, "intersection {"), 1u);
     EXPECT_EQ(occurrences(s, "difference {"), 1u);
@@ -204,7 +203,7 @@ TEST(PovWriter, BigUnionsAreRegroupedIntoABalancedNest) {
     for (int i = 0; i < 1000; ++i)
         parts.push_back(
             transform(g, TransformOp::Move, {double(i) * 3, 0, 0}, primitive(g, P::Sphere)));
-    g.axiom = g.addNode(NodeKind::Union, kNone, parts);
+    g.axiom = g.addOperator(CsgOp::Union, parts);
     const ExpandedTree t = expand(g);
     std::ostringstream os;
     // Bounded unions here only to see the groups' extents.
@@ -259,9 +258,8 @@ TEST(PovWriter, LongUnionChainsAreFlattenedBeforePovRaysBraceLimit) {
     defaultScene(g);
     NodeId n = primitive(g, P::Cube);
     for (int i = 0; i < 30000; ++i)
-        n = g.addNode(
-            NodeKind::Union, kNone,
-            {n, transform(g, TransformOp::Move, {0.001 * i, 0, 0}, primitive(g, P::Sphere))});
+        n = g.addOperator(CsgOp::Union, {n, transform(g, TransformOp::Move, {0.001 * i, 0, 0},
+                                                      primitive(g, P::Sphere))});
     g.axiom = n;
     const std::string s = exportText(g);
     int depth = 0, maxDepth = 0;
@@ -425,8 +423,8 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
         const auto inPlane = solid(P::Plane, pl), inSphere = solid(P::Sphere, Affine{});
         cases.push_back({"plane_cap",
                          [=](Graph& g) {
-                             return g.addNode(
-                                 NodeKind::Intersection, kNone,
+                             return g.addOperator(
+                                 CsgOp::Intersection,
                                  {node(g, pl, primitive(g, P::Plane)), primitive(g, P::Sphere)});
                          },
                          [=](const Vec3& p) { return inPlane(p) && inSphere(p); }, nullptr});
@@ -438,39 +436,40 @@ TEST(PovRay, SilhouettesMatchTheLanguagesSolids) {
             mat(TransformOp::Move, {0, 0, -2}) * mat(TransformOp::Scale, {0.4, 0.4, 4});
         const auto inCube = solid(P::Cube, spin), inS = solid(P::Sphere, spin * s),
                    inC = solid(P::Cylinder, spin * c);
-        cases.push_back(
-            {"difference",
-             [=](Graph& g) {
-                 return node(g, spin,
-                             g.addNode(NodeKind::Difference, kNone,
-                                       {primitive(g, P::Cube), node(g, s, primitive(g, P::Sphere)),
-                                        node(g, c, primitive(g, P::Cylinder))}));
-             },
-             [=](const Vec3& p) { return inCube(p) && !inS(p) && !inC(p); }, nullptr});
+        cases.push_back({"difference",
+                         [=](Graph& g) {
+                             return node(g, spin,
+                                         g.addOperator(CsgOp::Difference,
+                                                       {primitive(g, P::Cube),
+                                                        node(g, s, primitive(g, P::Sphere)),
+                                                        node(g, c, primitive(g, P::Cylinder))}));
+                         },
+                         [=](const Vec3& p) { return inCube(p) && !inS(p) && !inC(p); }, nullptr});
     }
     {
         // Triangles: tri1, tri2 and a general one, tilted.
         const Affine m = spin * mat(TransformOp::UScale, {1.5});
         const std::vector<double> corners = {0.2, 0.3, 0.9, -0.8, 0.5, 0.2, 0.1, -0.9, 0.4};
-        cases.push_back({"triangles",
-                         [=](Graph& g) {
-                             return node(g, m,
-                                         g.addNode(NodeKind::Union, kNone,
-                                                   {primitive(g, P::Tri1), primitive(g, P::Tri2),
-                                                    primitive(g, P::Triangle, corners)}));
-                         },
-                         nullptr,
-                         [=](const Vec3& o, const Vec3& d) {
-                             const Vec3 c[3][3] = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
-                                                   {{0, 0, 0}, {-1, 0, 0}, {0, -1, 0}},
-                                                   {{corners[0], corners[1], corners[2]},
-                                                    {corners[3], corners[4], corners[5]},
-                                                    {corners[6], corners[7], corners[8]}}};
-                             for (const auto& t : c)
-                                 if (rayTriangle(o, d, m.point(t[0]), m.point(t[1]), m.point(t[2])))
-                                     return true;
-                             return false;
-                         }});
+        cases.push_back(
+            {"triangles",
+             [=](Graph& g) {
+                 return node(
+                     g, m,
+                     g.addOperator(CsgOp::Union, {primitive(g, P::Tri1), primitive(g, P::Tri2),
+                                                  primitive(g, P::Triangle, corners)}));
+             },
+             nullptr,
+             [=](const Vec3& o, const Vec3& d) {
+                 const Vec3 c[3][3] = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+                                       {{0, 0, 0}, {-1, 0, 0}, {0, -1, 0}},
+                                       {{corners[0], corners[1], corners[2]},
+                                        {corners[3], corners[4], corners[5]},
+                                        {corners[6], corners[7], corners[8]}}};
+                 for (const auto& t : c)
+                     if (rayTriangle(o, d, m.point(t[0]), m.point(t[1]), m.point(t[2])))
+                         return true;
+                 return false;
+             }});
     }
 
     std::vector<povtest::PovJob> jobs;
@@ -552,7 +551,7 @@ TEST(PovRay, ParsesAndRendersEveryPrimitiveWithoutWarnings) {
     }
     parts.push_back(transform(g, TransformOp::Move, {-3, 0, 0}, primitive(g, P::Torus, {1, 0.3})));
     parts.push_back(transform(g, TransformOp::Move, {0, 0, -1.5}, primitive(g, P::Plane)));
-    g.axiom = g.addNode(NodeKind::Union, kNone, parts);
+    g.axiom = g.addOperator(CsgOp::Union, parts);
     g.scene.camera.location = {5, -20, 3};
     g.scene.camera.lookAt = {5, 0, 0.5};
     PovOptions opt;

@@ -143,7 +143,7 @@ inline Graph sierpinski(int order, PrimitiveKind leaf = PrimitiveKind::Tetrahedr
     for (const auto& k : corners)
         parts.push_back(transform(g, TransformOp::Move, {k[0], k[1], k[2]},
                                   transform(g, TransformOp::UScale, {0.5}, s)));
-    const NodeId u = g.addNode(NodeKind::Union, kNone, parts);
+    const NodeId u = g.addOperator(CsgOp::Union, parts);
     setRule(g, s, 1, calc(g, {{c, plusConst(g, c, -1)}}, u));
     g.axiom = calc(g, {{c, g.addConstant(order)}}, s);
     return g;
@@ -169,8 +169,7 @@ inline Graph stochastic(int depth) {
     const NodeId up =
         transform(g, TransformOp::Move, {0, 0, 1}, transform(g, TransformOp::UScale, {0.6}, b));
     const NodeId turned = transform(g, TransformOp::RotZ, {90}, b);
-    const NodeId u =
-        g.addNode(NodeKind::Union, kNone, {up, turned, primitive(g, PrimitiveKind::Cube)});
+    const NodeId u = g.addOperator(CsgOp::Union, {up, turned, primitive(g, PrimitiveKind::Cube)});
     setRule(g, b, 1, calc(g, {{d, plusConst(g, d, -1)}}, u));
     g.axiom = calc(g, {{d, g.addConstant(depth)}}, b);
     return g;

@@ -24,23 +24,25 @@ struct CheckOptions {
 // The node kinds in the order they are printed: JSON key, label for people.
 struct KindName {
     NodeKind kind;
+    CsgOp op;  // for NodeKind::Operator
     const char* key;
     const char* label;
 };
 constexpr KindName kKinds[] = {
-    {NodeKind::Select, "select", "S-nodes (select)"},
-    {NodeKind::Transform, "transform", "T-nodes (transform)"},
-    {NodeKind::Calc, "calc", "C-nodes (calculate)"},
-    {NodeKind::Paint, "paint", "paint nodes"},
-    {NodeKind::Union, "union", "∪ nodes (union)"},
-    {NodeKind::Intersection, "intersection", "∩ nodes (intersection)"},
-    {NodeKind::Difference, "difference", "\\ nodes (difference)"},
-    {NodeKind::Primitive, "primitive", "primitives"},
+    {NodeKind::Select, {}, "select", "S-nodes (select)"},
+    {NodeKind::Transform, {}, "transform", "T-nodes (transform)"},
+    {NodeKind::Calc, {}, "calc", "C-nodes (calculate)"},
+    {NodeKind::Paint, {}, "paint", "paint nodes"},
+    {NodeKind::Operator, CsgOp::Union, "union", "∪ nodes (union)"},
+    {NodeKind::Operator, CsgOp::Intersection, "intersection", "∩ nodes (intersection)"},
+    {NodeKind::Operator, CsgOp::Difference, "difference", "\\ nodes (difference)"},
+    {NodeKind::Primitive, {}, "primitive", "primitives"},
 };
 
-size_t countKind(const Graph& g, NodeKind kind) {
+size_t countKind(const Graph& g, const KindName& kind) {
     size_t n = 0;
-    for (const Node& node : g.nodes) n += node.kind == kind;
+    for (const Node& node : g.nodes)
+        n += node.kind == kind.kind && (kind.kind != NodeKind::Operator || node.op() == kind.op);
     return n;
 }
 
@@ -60,7 +62,7 @@ int runCheck(const CheckOptions& o) {
         nlohmann::json j = stats.toJson();
         j["ok"] = true;
         nlohmann::json nodes;
-        for (const KindName& k : kKinds) nodes[k.key] = countKind(g, k.kind);
+        for (const KindName& k : kKinds) nodes[k.key] = countKind(g, k);
         nodes["total"] = g.nodes.size();
         j["nodes"] = nodes;
         j["edges"] = g.edges.size();
@@ -83,7 +85,7 @@ int runCheck(const CheckOptions& o) {
         std::cout << label << std::string(width < 24 ? 24 - width : 1, ' ') << value << "\n";
     };
     line("scene", o.scene);
-    for (const KindName& k : kKinds) line(k.label, fmt::format("{}", countKind(g, k.kind)));
+    for (const KindName& k : kKinds) line(k.label, fmt::format("{}", countKind(g, k)));
     line("nodes", fmt::format("{}", g.nodes.size()));
     line("edges", fmt::format("{}", g.edges.size()));
     line("modules", fmt::format("{}", g.modules.size()));

@@ -170,9 +170,7 @@ std::string nodeStyle(const Graph& g, NodeId id) {
                 R"(shape=box, style="rounded,filled", fillcolor="{}", fontcolor="{}")", fill,
                 lum < 0.45 ? "white" : "black");
         }
-        case NodeKind::Union:
-        case NodeKind::Intersection:
-        case NodeKind::Difference:
+        case NodeKind::Operator:
             return R"(shape=circle, width=0.35, fixedsize=true, fontsize=14)";
         case NodeKind::Primitive:
             return R"(shape=ellipse, style=filled, fillcolor="#eeeeee")";
@@ -265,12 +263,8 @@ std::string nodeLabel(const Graph& g, NodeId id) {
         }
         case NodeKind::Paint:
             return "paint(" + materialName(g, n.payload) + ")";
-        case NodeKind::Union:
-            return "∪";
-        case NodeKind::Intersection:
-            return "∩";
-        case NodeKind::Difference:
-            return "\\";
+        case NodeKind::Operator:
+            return n.is(CsgOp::Union) ? "∪" : n.is(CsgOp::Intersection) ? "∩" : "\\";
         case NodeKind::Primitive: {
             if (n.payload >= g.primitives.size()) return "primitive";
             const Primitive& p = g.primitives[n.payload];

@@ -88,7 +88,7 @@ Graph sierpinski() {
     for (auto& m : moves)
         parts.push_back(transform(g, TransformOp::Move, {m[0], m[1], m[2]},
                                   transform(g, TransformOp::UScale, {"0.5"}, s)));
-    const NodeId u = g.addNode(NodeKind::Union, kNone, parts);
+    const NodeId u = g.addOperator(CsgOp::Union, parts);
     setRule(g, s, 2, calc(g, {{"c", "c-1"}}, u));
     g.axiom = calc(g, {{"c", "6"}}, s);
     return g;
@@ -192,12 +192,11 @@ TEST(GraphDot, SierpinskiDotText) {
 TEST(GraphDot, ASharedDefinitionIsDrawnOnce) {
     Graph g;
     // Leaf = sphere \ cube, used by both operands of a union.
-    const NodeId leaf =
-        g.addNode(NodeKind::Difference, kNone,
-                  {primitive(g, PrimitiveKind::Sphere), primitive(g, PrimitiveKind::Cube)});
+    const NodeId leaf = g.addOperator(CsgOp::Difference, {primitive(g, PrimitiveKind::Sphere),
+                                                          primitive(g, PrimitiveKind::Cube)});
     const NodeId a = transform(g, TransformOp::RotZ, {"45"}, leaf);
     const NodeId b = transform(g, TransformOp::FlipXZ, {}, leaf);
-    g.axiom = g.addNode(NodeKind::Union, kNone, {a, b});
+    g.axiom = g.addOperator(CsgOp::Union, {a, b});
     const std::string dot = toDot(g);
 
     const std::string decl = fmt::format("n{} [label=", leaf);
@@ -220,15 +219,13 @@ TEST(GraphDot, MutualRecursionBreaksEveryCycleAtAnSNode) {
     setRule(g, t2, 1, primitive(g, PrimitiveKind::Tri2));
     setRule(g, t1, 2,
             calc(g, {{"n", "n-1"}},
-                 g.addNode(NodeKind::Union, kNone,
-                           {transform(g, TransformOp::UScale, {"0.5"}, t1),
-                            transform(g, TransformOp::UScale, {"0.5"}, t2)})));
+                 g.addOperator(CsgOp::Union, {transform(g, TransformOp::UScale, {"0.5"}, t1),
+                                              transform(g, TransformOp::UScale, {"0.5"}, t2)})));
     setRule(g, t2, 2,
             calc(g, {{"n", "n-1"}},
-                 g.addNode(NodeKind::Union, kNone,
-                           {transform(g, TransformOp::UScale, {"0.5"}, t2),
-                            transform(g, TransformOp::UScale, {"0.5"}, t1)})));
-    g.axiom = calc(g, {{"n", "5"}}, g.addNode(NodeKind::Union, kNone, {t1, t2}));
+                 g.addOperator(CsgOp::Union, {transform(g, TransformOp::UScale, {"0.5"}, t2),
+                                              transform(g, TransformOp::UScale, {"0.5"}, t1)})));
+    g.axiom = calc(g, {{"n", "5"}}, g.addOperator(CsgOp::Union, {t1, t2}));
 
     const DotLayout l = layoutGraph(g);
     EXPECT_TRUE(acyclicWithoutBackEdges(g, l));
@@ -271,8 +268,7 @@ TEST(GraphDot, LabelsOfEveryKind) {
     const NodeId torus = primitive(g, PrimitiveKind::Torus, {"R", "r*0.5"});
     const NodeId p = g.addNode(NodeKind::Paint, 1, {torus});
     const NodeId c = calc(g, {{"sd", "rand(x)"}, {"rnd", "sd*2"}}, p);
-    const NodeId i =
-        g.addNode(NodeKind::Intersection, kNone, {c, primitive(g, PrimitiveKind::Plane)});
+    const NodeId i = g.addOperator(CsgOp::Intersection, {c, primitive(g, PrimitiveKind::Plane)});
     g.axiom = transform(g, TransformOp::Matrix,
                         {"1", "0", "0", "0", "1", "0", "0", "0", "1", "0", "0", "2"}, i);
 
@@ -303,7 +299,7 @@ TEST(GraphDot, LongAndOddTextIsShortenedAndEscaped) {
 TEST(GraphDot, AVeryDeepChainDoesNotExhaustTheStack) {
     Graph g;
     NodeId n = primitive(g, PrimitiveKind::Sphere);
-    for (int i = 0; i < 200000; ++i) n = g.addNode(NodeKind::Union, kNone, {n});
+    for (int i = 0; i < 200000; ++i) n = g.addOperator(CsgOp::Union, {n});
     g.axiom = n;
     const DotLayout l = layoutGraph(g);
     EXPECT_EQ(l.order.size(), g.nodes.size());

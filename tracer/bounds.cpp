@@ -172,9 +172,7 @@ class Analysis {
             case NodeKind::Paint:
                 push(g_.child(n), st);
                 return;
-            case NodeKind::Union:
-            case NodeKind::Intersection:
-            case NodeKind::Difference:
+            case NodeKind::Operator:
                 for (uint32_t i = 0; i < node.childCount; ++i) push(g_.child(n, i), st);
                 return;
             case NodeKind::Primitive: {
@@ -326,19 +324,9 @@ class Analysis {
                 if (!rec.matrixOk[ti]) return Box::empty();
                 return tracer::transformBox(rec.matrix[ti], c);
             }
-            case NodeKind::Union: {
-                Box b;
-                for (uint32_t i = 0; i < node.childCount; ++i) b = unite(b, child(g_.child(n, i)));
-                return b;
-            }
-            case NodeKind::Intersection: {
-                Box b = Box::everything();
-                for (uint32_t i = 0; i < node.childCount; ++i)
-                    b = intersect(b, child(g_.child(n, i)));
-                return b.isEmpty() ? Box::empty() : b;
-            }
-            case NodeKind::Difference:
-                return node.childCount ? child(g_.child(n, 0)) : Box::empty();
+            case NodeKind::Operator:
+                return csgBox(node.op(), node.childCount,
+                              [&](uint32_t i) { return child(g_.child(n, i)); });
         }
         return Box::everything();
     }

@@ -54,12 +54,8 @@ const char* kindName(NodeKind k) {
             return "C";
         case NodeKind::Paint:
             return "paint";
-        case NodeKind::Union:
-            return "union";
-        case NodeKind::Intersection:
-            return "intersection";
-        case NodeKind::Difference:
-            return "difference";
+        case NodeKind::Operator:
+            return "operator";
         case NodeKind::Primitive:
             return "primitive";
     }
@@ -139,8 +135,8 @@ class StreamingSoundness {
     }
 
     bool clips(const Entry& e) const {
-        const NodeKind k = g_.nodes[e.node].kind;
-        return k == NodeKind::Intersection || (k == NodeKind::Difference && e.childTaken > 0);
+        const Node& n = g_.nodes[e.node];
+        return n.is(CsgOp::Intersection) || (n.is(CsgOp::Difference) && e.childTaken > 0);
     }
 
     Box ownBox(NodeId n, uint32_t depth) const {
@@ -195,9 +191,7 @@ class StreamingSoundness {
             case NodeKind::Paint:
                 walk(g_.child(n), frame, level, path, depth, frameIndex);
                 break;
-            case NodeKind::Union:
-            case NodeKind::Intersection:
-            case NodeKind::Difference:
+            case NodeKind::Operator:
                 for (uint32_t i = 0; i < node.childCount; ++i) {
                     path_.back().childTaken = i;
                     walk(g_.child(n, i), frame, level, pathChild(path, i), depth, frameIndex);
@@ -239,7 +233,7 @@ class StreamingSoundness {
                 const Node& c = g_.nodes[up.node];
                 for (uint32_t i = 0; i < c.childCount; ++i) {
                     if (i == up.childTaken) continue;
-                    if (c.kind == NodeKind::Difference && i > 0) break;
+                    if (c.is(CsgOp::Difference) && i > 0) break;
                     region = intersect(region, b_.node[g_.child(up.node, i)]);
                 }
                 regionToWorld = &frames_[up.frame].toWorld;
@@ -362,9 +356,8 @@ TEST(BoundsOnScenesCheck, DetectsABoxThatIsTooSmall) {
                                   << " shrunk without a report";
         shrunk[k] = true;
     }
-    for (NodeKind k :
-         {NodeKind::Select, NodeKind::Transform, NodeKind::Calc, NodeKind::Paint, NodeKind::Union,
-          NodeKind::Intersection, NodeKind::Difference, NodeKind::Primitive})
+    for (NodeKind k : {NodeKind::Select, NodeKind::Transform, NodeKind::Calc, NodeKind::Paint,
+                       NodeKind::Operator, NodeKind::Primitive})
         EXPECT_TRUE(shrunk[static_cast<size_t>(k)]) << "no " << kindName(k) << "-node tried";
 }
 

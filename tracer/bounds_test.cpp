@@ -68,9 +68,9 @@ size_t checkSound(const Graph& g, const Bounds& b, const std::vector<testing::In
         size_t clip = 0;
         bool clipped = false;
         for (size_t j = 0; j < inst.path.size(); ++j) {
-            const NodeKind k = g.nodes[inst.path[j].node].kind;
-            if (k == NodeKind::Intersection ||
-                (k == NodeKind::Difference && inst.path[j].childTaken > 0)) {
+            const Node& k = g.nodes[inst.path[j].node];
+            if (k.is(CsgOp::Intersection) ||
+                (k.is(CsgOp::Difference) && inst.path[j].childTaken > 0)) {
                 clip = j;
                 clipped = true;
             }

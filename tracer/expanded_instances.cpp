@@ -15,6 +15,10 @@ namespace {
 
 constexpr uint32_t kRuleBit = 1u << 31;
 
+bool isUnion(const ExpandedInstance::Node& n) {
+    return n.kind == ExpandedInstance::Kind::Operator && n.op == CsgOp::Union;
+}
+
 // The expansion took more visits than its depth promised: leave it to the graph walk.
 struct TooLarge {};
 
@@ -108,12 +112,8 @@ class ExpansionBuilder {
             }
             case NodeKind::Paint:
                 return build(g_.child(n), frame, path, depth, node.payload, pendingBase, edge);
-            case NodeKind::Union:
-            case NodeKind::Intersection:
-            case NodeKind::Difference: {
-                const Kind kind = node.kind == NodeKind::Union          ? Kind::Union
-                                  : node.kind == NodeKind::Intersection ? Kind::Intersection
-                                                                        : Kind::Difference;
+            case NodeKind::Operator: {
+                const CsgOp op = node.op();
                 std::vector<uint32_t> kids;
                 const size_t mark = pending_.size();
                 for (uint32_t i = 0; i < node.childCount; ++i) {
@@ -122,10 +122,7 @@ class ExpansionBuilder {
                                              material, mark, Affine::identity());
                     choices_.pop_back();
                     if (c == kNone) {
-                        // Nothing there: an intersection holds nothing, and so does a
-                        // difference whose first operand holds nothing.
-                        if (kind == Kind::Intersection || (kind == Kind::Difference && i == 0))
-                            return kNone;
+                        if (emptyOperandEmptiesAll(op, i)) return kNone;
                         continue;
                     }
                     kids.push_back(c);
@@ -134,14 +131,15 @@ class ExpansionBuilder {
                 Box inside = out_.nodes_[kids[0]].box;
                 for (size_t k = 1; k < kids.size(); ++k) {
                     const Box& b = out_.nodes_[kids[k]].box;
-                    if (kind == Kind::Union) inside.extend(b);
-                    if (kind == Kind::Intersection) inside = intersect(inside, b);
+                    if (op == CsgOp::Union) inside.extend(b);
+                    if (op == CsgOp::Intersection) inside = intersect(inside, b);
                 }
-                Node x = emit(kind, material, pendingBase, edge, inside);
+                Node x = emit(Kind::Operator, material, pendingBase, edge, inside);
+                x.op = op;
                 x.first = static_cast<uint32_t>(out_.children_.size());
                 x.count = static_cast<uint32_t>(kids.size());
                 out_.children_.insert(out_.children_.end(), kids.begin(), kids.end());
-                if (kind != Kind::Union) setChoices(x);
+                if (op != CsgOp::Union) setChoices(x);
                 out_.nodes_.push_back(x);
                 return static_cast<uint32_t>(out_.nodes_.size() - 1);
             }
@@ -206,7 +204,7 @@ class ExpansionBuilder {
             std::vector<Affine> chain = prefix;
             chain.insert(chain.end(), out_.matrices_.begin() + child.firstMatrix,
                          out_.matrices_.begin() + child.firstMatrix + child.matrices);
-            if (child.kind == Kind::Union && chain.size() <= kMaxChain) {
+            if (isUnion(child) && chain.size() <= kMaxChain) {
                 Affine to = toU;
                 for (uint32_t k = 0; k < child.matrices; ++k)
                     to = to * out_.matrices_[child.firstMatrix + k].inverse();
@@ -231,7 +229,7 @@ class ExpansionBuilder {
 
     // Builds the BVHs of the unions that first hits reach through n.
     void hierarchy(uint32_t n) {
-        if (out_.nodes_[n].kind != Kind::Union) return;
+        if (!isUnion(out_.nodes_[n])) return;
         std::vector<uint32_t> items;
         collect(n, {}, Affine::identity(), items);
         for (uint32_t item : items) hierarchy(item);  // unions beyond the chain limit
@@ -381,7 +379,17 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             }
             break;
         }
-        case Kind::Union:
+        case Kind::Operator:
+            if (node.op != CsgOp::Union) {
+                std::vector<Span>& buffer = s.spans;
+                const size_t base = buffer.size();
+                const size_t count = spansAt(n, r, tmin, tmax, buffer, use, s);
+                // spansAt left the normals in the frame this node is entered from.
+                found = boundaryHit(buffer, base, count, tmin, tmax, keyOf(node, use.path), hit);
+                buffer.resize(base);
+                if (found) tmax = hit.t;
+                return found;
+            }
             if (node.bvh != kNone) {
                 found = firstBvh(node.bvh, rr, tmin, tmax, hit, use, anyHit, s);
                 break;
@@ -389,17 +397,6 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             found = firstOfNodes(children_.data() + node.first, node.count, rr, tmin, tmax, hit,
                                  use, anyHit, s);
             break;
-        case Kind::Intersection:
-        case Kind::Difference: {
-            std::vector<Span>& buffer = s.spans;
-            const size_t base = buffer.size();
-            const size_t count = spansAt(n, r, tmin, tmax, buffer, use, s);
-            // spansAt left the normals in the frame this node is entered from.
-            found = boundaryHit(buffer, base, count, tmin, tmax, keyOf(node, use.path), hit);
-            buffer.resize(base);
-            if (found) tmax = hit.t;
-            return found;
-        }
     }
     if (found) hit.normal = leave(node, hit.normal);
     return found;
@@ -459,14 +456,9 @@ size_t ExpandedInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
             count = static_cast<size_t>(k);
             break;
         }
-        case Kind::Union:
-        case Kind::Intersection:
-        case Kind::Difference: {
-            const NodeKind kind = node.kind == Kind::Union          ? NodeKind::Union
-                                  : node.kind == Kind::Intersection ? NodeKind::Intersection
-                                                                    : NodeKind::Difference;
+        case Kind::Operator: {
             count = combineOperands(
-                kind, node.count, spans, tmin, tmax,
+                node.op, node.count, spans, tmin, tmax,
                 [&](uint32_t i, double lo, double hi) {
                     return clipToBox(nodes_[children_[node.first + i]].box, rr.o, rr.d, lo, hi);
                 },

@@ -45,10 +45,11 @@ class ExpandedInstance {
   public:
     static constexpr uint32_t kInherit = UINT32_MAX;  // material: the caller's
 
-    enum class Kind : uint8_t { Solid, Triangle, Union, Intersection, Difference };
+    enum class Kind : uint8_t { Solid, Triangle, Operator };
 
     struct Node {
         Kind kind;
+        CsgOp op = CsgOp::Union;  // operators
         PrimitiveKind prim = PrimitiveKind::Empty;
         uint32_t material = kInherit;            // primitives: the innermost paint inside
         uint32_t firstMatrix = 0, matrices = 0;  // inverse matrices applied on entering

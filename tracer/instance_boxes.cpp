@@ -202,22 +202,9 @@ class BoxSink {
 
     void beginOperator(WalkEntry&) {}
 
-    Result endOperator(TreeKind kind, const Result* r, uint32_t n, const WalkEntry&) const {
+    Result endOperator(CsgOp op, const Result* r, uint32_t n, const WalkEntry&) const {
         Result out;
-        if (n == 0) return out;
-        switch (kind) {
-            case TreeKind::Intersection:
-                out.box = r[0].box;
-                for (uint32_t i = 1; i < n; ++i) out.box = intersect(out.box, r[i].box);
-                break;
-            case TreeKind::Difference:
-                out.box = r[0].box;  // A \ B lies inside A
-                break;
-            default:
-                for (uint32_t i = 0; i < n; ++i) out.box.extend(r[i].box);
-                break;
-        }
-        if (out.box.isEmpty()) out.box = Box::empty();
+        out.box = csgBox(op, n, [&](uint32_t i) { return r[i].box; });
         return out;
     }
 

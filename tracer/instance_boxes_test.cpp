@@ -99,12 +99,10 @@ class SoundnessWalk {
             case NodeKind::Paint:
                 walk(g_.child(n), frame, path, depth, world, checkFrom);
                 break;
-            case NodeKind::Union:
-            case NodeKind::Intersection:
-            case NodeKind::Difference:
+            case NodeKind::Operator:
                 for (uint32_t i = 0; i < node.childCount; ++i)
                     walk(g_.child(n, i), frame, pathChild(path, i), depth, world,
-                         node.kind == NodeKind::Union ? checkFrom : open_.size());
+                         node.is(CsgOp::Union) ? checkFrom : open_.size());
                 break;
             case NodeKind::Primitive: {
                 const Primitive& p = g_.primitives[node.payload];
@@ -239,7 +237,7 @@ TEST(InstanceBoxes, TerrainInstancesAreMuchTighterThanTheStaticBoxes) {
             applyCalc(g, n, EvalState{frame.data(), path}, next.data());
             frame.swap(next);
             n = g.child(n);
-        } else if (node.kind == NodeKind::Union) {
+        } else if (node.is(CsgOp::Union)) {
             path = pathChild(path, 0);
             n = g.child(n, 0);
         } else {

@@ -109,21 +109,20 @@ inline bool boundaryHit(const std::vector<Span>& spans, size_t base, size_t coun
     return false;
 }
 
-// The span list of an operator (kind Union, Intersection or Difference) over `count`
+// The span list of an operator over `count`
 // operands, appended to `spans` at its end; returns the number of spans. `inWindow(i, lo,
 // hi)` says whether operand i's box meets the window [lo, hi]; `operand(i, lo, hi)`
 // appends operand i's spans and returns their number.
 template <class InWindow, class Operand>
-size_t combineOperands(NodeKind kind, uint32_t count, std::vector<Span>& spans, double tmin,
-                       double tmax, InWindow inWindow, Operand operand) {
+size_t combineOperands(CsgOp op, uint32_t count, std::vector<Span>& spans, double tmin, double tmax,
+                       InWindow inWindow, Operand operand) {
     const size_t base = spans.size();
     size_t acc = 0;
     double lo = tmin, hi = tmax;
     for (uint32_t i = 0; i < count; ++i) {
         // Empty in the window: an intersection becomes empty, and so does a difference
         // whose first operand is.
-        const bool emptiesAll =
-            kind == NodeKind::Intersection || (kind == NodeKind::Difference && i == 0);
+        const bool emptiesAll = emptyOperandEmptiesAll(op, i);
         if (!inWindow(i, lo, hi)) {
             if (emptiesAll) {
                 spans.resize(base);
@@ -140,7 +139,7 @@ size_t combineOperands(NodeKind kind, uint32_t count, std::vector<Span>& spans, 
             }
             continue;
         }
-        if (i == 0 || (kind == NodeKind::Union && acc == 0)) {
+        if (i == 0 || (op == CsgOp::Union && acc == 0)) {
             acc = n;  // already at base
         } else {
             // Combine [base, base+acc) with [cbase, cbase+n) above them, then move the
@@ -149,24 +148,24 @@ size_t combineOperands(NodeKind kind, uint32_t count, std::vector<Span>& spans, 
             spans.resize(rbase + acc + n);
             Span* s = spans.data();
             size_t m = 0;
-            switch (kind) {
-                case NodeKind::Union:
+            switch (op) {
+                case CsgOp::Union:
                     m = uniteSpans(s + base, acc, s + cbase, n, s + rbase);
                     break;
-                case NodeKind::Intersection:
+                case CsgOp::Intersection:
                     m = intersectSpans(s + base, acc, s + cbase, n, s + rbase);
                     break;
-                default:
+                case CsgOp::Difference:
                     m = subtractSpans(s + base, acc, s + cbase, n, s + rbase);
                     break;
             }
             std::memmove(static_cast<void*>(s + base), s + rbase, m * sizeof(Span));
             acc = m;
             spans.resize(base + acc);
-            if (acc == 0 && kind != NodeKind::Union) return 0;
+            if (acc == 0 && op != CsgOp::Union) return 0;
         }
         // ∩ and \ never grow beyond their first operand: narrow the window.
-        if (kind != NodeKind::Union) {
+        if (op != CsgOp::Union) {
             lo = std::max(lo, spans[base].in.t);
             hi = std::min(hi, spans[base + acc - 1].out.t);
         }

@@ -92,9 +92,7 @@ class Expander {
             case NodeKind::Paint:
                 walk(g_.child(n), frame, path, depth, world, node.payload);
                 break;
-            case NodeKind::Union:
-            case NodeKind::Intersection:
-            case NodeKind::Difference:
+            case NodeKind::Operator:
                 for (uint32_t i = 0; i < node.childCount; ++i) {
                     path_.back().childTaken = i;
                     walk(g_.child(n, i), frame, pathChild(path, i), depth, world, material);

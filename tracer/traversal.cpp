@@ -250,6 +250,17 @@ auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
     }
 }
 
+// The first boundary of the span list of an intersection or a difference.
+bool Tracer::firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
+                          Hit& hit) {
+    const size_t base = spans_.size();
+    const size_t count = spans(n, r, c, tmin, tmax);
+    const bool found = boundaryHit(spans_, base, count, tmin, tmax, c.path, hit);
+    spans_.resize(base);
+    if (found) tmax = hit.t;
+    return found;
+}
+
 bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit) {
     ++visits_;
     const Node& node = g_.nodes[n];
@@ -272,7 +283,8 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                     hit.normal = inv.transposedVector(hit.normal);
                     return true;
                 });
-        case NodeKind::Union:
+        case NodeKind::Operator:
+            if (node.op() != CsgOp::Union) return firstOfSolid(n, r, c, tmin, tmax, hit);
             return firstOfUnion(
                 node.childCount, tmin, tmax, hit, anyHit_, order_,
                 [&](uint32_t i, double& t0) {
@@ -284,15 +296,6 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                     const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
                     return first(g_.child(n, i), r, cc, tmin, best, h);
                 });
-        case NodeKind::Intersection:
-        case NodeKind::Difference: {
-            const size_t base = spans_.size();
-            const size_t count = spans(n, r, c, tmin, tmax);
-            const bool found = boundaryHit(spans_, base, count, tmin, tmax, c.path, hit);
-            spans_.resize(base);
-            if (found) tmax = hit.t;
-            return found;
-        }
         case NodeKind::Primitive: {
             const Primitive& p = g_.primitives[node.payload];
             double args[9] = {};
@@ -354,11 +357,9 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
                     }
                     return count;
                 });
-        case NodeKind::Union:
-        case NodeKind::Intersection:
-        case NodeKind::Difference:
+        case NodeKind::Operator:
             return combineOperands(
-                node.kind, node.childCount, spans_, tmin, tmax,
+                node.op(), node.childCount, spans_, tmin, tmax,
                 [&](uint32_t i, double lo, double hi) {
                     return !scene_.useBounds ||
                            clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, lo, hi);

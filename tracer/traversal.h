@@ -153,6 +153,8 @@ class Tracer {
     };
 
     bool first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit);
+    bool firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
+                      Hit& hit);
     size_t spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax);
     bool selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
                       double tmax);

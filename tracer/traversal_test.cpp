@@ -80,14 +80,12 @@ class Reference {
             int parent = -1;
             uint32_t key = 0;
             for (const auto& pn : in.path) {
-                const NodeKind k = g.nodes[pn.node].kind;
-                if (k != NodeKind::Union && k != NodeKind::Intersection &&
-                    k != NodeKind::Difference)
-                    continue;
+                const Node& k = g.nodes[pn.node];
+                if (k.kind != NodeKind::Operator) continue;
                 int c = childOf(parent, key);
                 if (c < 0) {
                     c = static_cast<int>(nodes_.size());
-                    nodes_.push_back(RNode{k, pn.node, -1, {}});
+                    nodes_.push_back(RNode{k.kind, k.op(), pn.node, -1, {}});
                     setChild(parent, key, c);
                 }
                 parent = c;
@@ -95,7 +93,7 @@ class Reference {
             }
             const int leaf = static_cast<int>(nodes_.size());
             nodes_.push_back(
-                RNode{NodeKind::Primitive, in.node, static_cast<int>(insts_.size() - 1), {}});
+                RNode{NodeKind::Primitive, {}, in.node, static_cast<int>(insts_.size() - 1), {}});
             EXPECT_LT(childOf(parent, key), 0) << "two instances on one path";
             setChild(parent, key, leaf);
         }
@@ -124,6 +122,7 @@ class Reference {
     };
     struct RNode {
         NodeKind kind;
+        CsgOp op;  // Operator
         NodeId graphNode;
         int inst;
         std::map<uint32_t, int> children;  // by operand index
@@ -188,10 +187,11 @@ class Reference {
                                                      {}});
                 return;
             }
-            case NodeKind::Union:
-                for (const auto& [key, c] : node.children) collectFirst(c, o, d, out);
-                return;
             default: {
+                if (node.kind == NodeKind::Operator && node.op == CsgOp::Union) {
+                    for (const auto& [key, c] : node.children) collectFirst(c, o, d, out);
+                    return;
+                }
                 std::vector<Candidate> cands;
                 collectSolid(n, 1.0, o, d, cands);
                 classify(n, cands, o, d, out);
@@ -219,28 +219,27 @@ class Reference {
             return;
         }
         for (const auto& [key, c] : node.children)
-            collectSolid(c, node.kind == NodeKind::Difference && key > 0 ? -parity : parity, o, d,
-                         out);
+            collectSolid(c, node.op == CsgOp::Difference && key > 0 ? -parity : parity, o, d, out);
     }
 
     bool inside(int n, const Vec3& p) const {
         const RNode& node = nodes_[n];
-        switch (node.kind) {
-            case NodeKind::Primitive: {
-                const Inst& in = insts_[node.inst];
-                return insideSolid(in.kind, in.args, in.fromWorld.point(p));
-            }
-            case NodeKind::Union:
+        if (node.kind == NodeKind::Primitive) {
+            const Inst& in = insts_[node.inst];
+            return insideSolid(in.kind, in.args, in.fromWorld.point(p));
+        }
+        switch (node.op) {
+            case CsgOp::Union:
                 for (const auto& [key, c] : node.children)
                     if (inside(c, p)) return true;
                 return false;
-            case NodeKind::Intersection:
+            case CsgOp::Intersection:
                 // An operand that expanded to nothing makes the intersection empty.
                 if (node.children.size() != g_.nodes[node.graphNode].childCount) return false;
                 for (const auto& [key, c] : node.children)
                     if (!inside(c, p)) return false;
                 return true;
-            default: {  // difference
+            case CsgOp::Difference: {
                 const auto first = node.children.find(0);
                 if (first == node.children.end() || !inside(first->second, p)) return false;
                 for (const auto& [key, c] : node.children)
@@ -248,6 +247,7 @@ class Reference {
                 return true;
             }
         }
+        return false;
     }
 
     // The candidates where the membership of n changes are its surfaces.
