@@ -1,12 +1,17 @@
-// The builder: AST -> Graph (docs/language.md sections 2-7).
+// The builder: AST -> Graph (docs/language.md sections 2-7), in phases over one shared
+// BuildContext and the Names it resolves (build_state.h):
 //
-// First the checks that need the whole file: modules declared and their rules numbered
-// 1..n exactly once, one notation per module, names that resolve, parameters that some
-// C-node or formal assigns, function and operator arities, materials, definitions that do
-// not refer to themselves through definitions only, exactly one axiom, and no triangle
-// under an intersection or a difference. Then the graph: one S-node per module, T-, C-
-// and paint nodes for the unary operators, n-ary operator nodes, primitives, each
-// definition built once and shared, expressions compiled to the stack code of graph.h.
+//  1. build_scene.h  the settings directive (its seed is used by later constants);
+//  2. build_names.h  material names;
+//  3. build_scene.h  camera, light, background and the materials' items;
+//  4. build_names.h  modules and their rules in notations A and B, definitions, assigned
+//                    parameters, exactly one axiom, the definition order and cycles;
+//  5. build_csg.h    S-, T-, C-, paint, operator and primitive nodes, each definition
+//                    built once and shared, with expressions compiled by build_exprs.h
+//                    to the stack code of graph.h;
+//  6. build_checks.h no triangle under an intersection or a difference.
+//
+// Every phase runs even after errors, so that one run reports as many as it can.
 #pragma once
 
 #include <optional>
