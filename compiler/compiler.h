@@ -1,7 +1,8 @@
 // The compiler's entry points: from .pcsg text to the cyclic CSG graph.
-// Phases: lexer.cpp (tokens, #define expansion) -> parser.cpp (AST, ast.h) ->
-// builder.cpp (name and arity checks, the Graph of graph.h) -> fold_constants.cpp
-// (parameters that are constants become constants).
+// Phases: lexer.cpp (tokens; #define in macros.cpp) -> parser.cpp (AST, ast.h) ->
+// builder.cpp (names, scene directives, expressions, CSG lowering and checks, in the
+// build_*.cpp files: the Graph of graph.h) -> fold_constants.cpp (parameters that are
+// constants become constants).
 #pragma once
 
 #include <optional>

@@ -1,4 +1,4 @@
-// The lexer: scanning, #define expansion and the newline rule. See lexer.h.
+// The lexer: scanning and the newline rule; #define is macros.cpp. See lexer.h.
 #include "lexer.h"
 
 #include <fmt/format.h>
@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cstring>
 #include <unordered_map>
+
+#include "macros.h"
 
 namespace pcsg {
 
@@ -171,6 +173,49 @@ bool full(const Diagnostics& d) {
     return d.errors().size() >= Diagnostics::kMaxErrors;
 }
 
+// ASCII punctuation: the token of a character, and of it followed by `second`.
+struct Punctuation {
+    Tok one = Tok::End;  // End: not punctuation
+    char second = '\0';
+    Tok two = Tok::End;
+};
+
+struct PunctuationTable {
+    Punctuation at[128];
+    constexpr const Punctuation& operator[](unsigned char c) const { return at[c & 0x7f]; }
+};
+
+constexpr PunctuationTable makePunctuationTable() {
+    PunctuationTable t;
+    auto one = [&](char c, Tok k) { t.at[static_cast<int>(c)] = Punctuation{k}; };
+    auto two = [&](char c, Tok k, char second, Tok pair) {
+        t.at[static_cast<int>(c)] = Punctuation{k, second, pair};
+    };
+    one('(', Tok::LParen);
+    one(')', Tok::RParen);
+    one('{', Tok::LBrace);
+    one('}', Tok::RBrace);
+    one(',', Tok::Comma);
+    one(';', Tok::Semicolon);
+    one(':', Tok::Colon);
+    one('+', Tok::Plus);
+    one('*', Tok::Star);
+    one('/', Tok::Slash);
+    one('%', Tok::Percent);
+    one('^', Tok::Caret);
+    one('\\', Tok::Difference);
+    two('-', Tok::Minus, '>', Tok::Arrow);
+    two('|', Tok::Union, '|', Tok::OrOr);
+    two('&', Tok::Intersect, '&', Tok::AndAnd);
+    two('=', Tok::Assign, '=', Tok::Eq);
+    two('!', Tok::Bang, '=', Tok::Ne);
+    two('<', Tok::Lt, '=', Tok::Le);
+    two('>', Tok::Gt, '=', Tok::Ge);
+    return t;
+}
+
+constexpr PunctuationTable kPunctuation = makePunctuationTable();
+
 class Scanner {
   public:
     Scanner(const Source& src, Diagnostics& diags, std::vector<Token>& out)
@@ -288,100 +333,15 @@ class Scanner {
     size_t punctuation(size_t i) {
         const size_t n = s_.size();
         const char c = s_[i];
-        const char d = i + 1 < n ? s_[i + 1] : '\0';
-        switch (c) {
-            case '(':
-                push(Tok::LParen, i, 1);
-                return i + 1;
-            case ')':
-                push(Tok::RParen, i, 1);
-                return i + 1;
-            case '{':
-                push(Tok::LBrace, i, 1);
-                return i + 1;
-            case '}':
-                push(Tok::RBrace, i, 1);
-                return i + 1;
-            case ',':
-                push(Tok::Comma, i, 1);
-                return i + 1;
-            case ';':
-                push(Tok::Semicolon, i, 1);
-                return i + 1;
-            case ':':
-                push(Tok::Colon, i, 1);
-                return i + 1;
-            case '+':
-                push(Tok::Plus, i, 1);
-                return i + 1;
-            case '*':
-                push(Tok::Star, i, 1);
-                return i + 1;
-            case '/':
-                push(Tok::Slash, i, 1);
-                return i + 1;
-            case '%':
-                push(Tok::Percent, i, 1);
-                return i + 1;
-            case '^':
-                push(Tok::Caret, i, 1);
-                return i + 1;
-            case '\\':
-                push(Tok::Difference, i, 1);
-                return i + 1;
-            case '#':
-                return hash(i);
-            case '-':
-                if (d == '>') {
-                    push(Tok::Arrow, i, 2);
-                    return i + 2;
-                }
-                push(Tok::Minus, i, 1);
-                return i + 1;
-            case '|':
-                if (d == '|') {
-                    push(Tok::OrOr, i, 2);
-                    return i + 2;
-                }
-                push(Tok::Union, i, 1);
-                return i + 1;
-            case '&':
-                if (d == '&') {
-                    push(Tok::AndAnd, i, 2);
-                    return i + 2;
-                }
-                push(Tok::Intersect, i, 1);
-                return i + 1;
-            case '=':
-                if (d == '=') {
-                    push(Tok::Eq, i, 2);
-                    return i + 2;
-                }
-                push(Tok::Assign, i, 1);
-                return i + 1;
-            case '!':
-                if (d == '=') {
-                    push(Tok::Ne, i, 2);
-                    return i + 2;
-                }
-                push(Tok::Bang, i, 1);
-                return i + 1;
-            case '<':
-                if (d == '=') {
-                    push(Tok::Le, i, 2);
-                    return i + 2;
-                }
-                push(Tok::Lt, i, 1);
-                return i + 1;
-            case '>':
-                if (d == '=') {
-                    push(Tok::Ge, i, 2);
-                    return i + 2;
-                }
-                push(Tok::Gt, i, 1);
-                return i + 1;
-            default:
-                break;
+        if (c == '#') return hash(i);
+        const Punctuation& p = kPunctuation[static_cast<unsigned char>(c)];
+        if (p.one != Tok::End) {
+            if (p.second != '\0' && i + 1 < n && s_[i + 1] == p.second) {
+                push(p.two, i, 2);
+                return i + 2;
+            }
+            push(p.one, i, 1);
+            return i + 1;
         }
         if (c == '\0') {
             error(i, "unexpected NUL byte: this does not look like a text file");
@@ -402,7 +362,8 @@ class Scanner {
     }
 
     // '#': a directive. Only #define exists; the line of any other is skipped here (the
-    // expander reports it), so that `#include "x"` gets one error, not one per quote.
+    // macro processor, macros.cpp, reports it), so that `#include "x"` gets one error, not one per
+    // quote.
     size_t hash(size_t i) {
         const size_t n = s_.size();
         const bool first = lineStart_;
@@ -476,277 +437,6 @@ class Scanner {
     std::string_view s_;
     std::vector<Token>& out_;
     bool lineStart_ = true;
-    bool stop_ = false;
-};
-
-// ---------------------------------------------------------------------------------------
-// Step 2: #define
-
-class Expander {
-  public:
-    Expander(const Source& src, Diagnostics& diags, const std::vector<Token>& raw,
-             std::vector<Token>& out)
-        : src_(src), diags_(diags), raw_(raw), out_(out) {}
-
-    void run() {
-        collect();
-        const size_t n = raw_.size() - 1;  // the last token is End
-        out_.reserve(n + n / 2 + 16);
-        size_t i = 0;
-        while (i < n && !stop_) {
-            const Token& t = raw_[i];
-            if (t.kind == Tok::Hash) {
-                i = directive(i);
-                continue;
-            }
-            if (macroAt_[i] != kNotMacro) {
-                use(macroAt_[i], t, t.flags & kLineStart);
-                ++i;
-                continue;
-            }
-            emit(t);
-            ++i;
-        }
-        out_.push_back(raw_.back());
-    }
-
-  private:
-  public:
-    bool stopped() const { return stop_; }
-
-  private:
-    struct Macro {
-        std::string_view name;
-        uint32_t hash = 0;                    // raw index of its '#'
-        uint32_t bodyBegin = 0, bodyEnd = 0;  // raw indices
-        bool defined = false;                 // its #define has been passed
-        bool reported = false;                // its self-expansion was reported
-    };
-    struct Frame {
-        uint32_t macro;
-        uint32_t pos;
-        bool lineStart;
-    };
-
-    void error(const Token& t, std::string message) {
-        diags_.error(src_.loc(t.offset), std::move(message));
-    }
-
-    bool sameLine(size_t i) const {
-        return i < raw_.size() && raw_[i].kind != Tok::End && !(raw_[i].flags & kLineStart);
-    }
-
-    // The first #define of every name, so that a use before it can be recognised.
-    void collect() {
-        const size_t n = raw_.size() - 1;
-        for (size_t i = 0; i + 2 < n; ++i) {
-            if (raw_[i].kind != Tok::Hash || !(raw_[i].flags & kLineStart)) continue;
-            if (!sameLine(i + 1) || raw_[i + 1].kind != Tok::Ident ||
-                spelling(src_, raw_[i + 1]) != "define")
-                continue;
-            if (!sameLine(i + 2) || raw_[i + 2].kind != Tok::Ident) continue;
-            const std::string_view name = spelling(src_, raw_[i + 2]);
-            if (byName_.count(name)) continue;
-            Macro m;
-            m.name = name;
-            m.hash = static_cast<uint32_t>(i);
-            byName_.emplace(name, static_cast<uint32_t>(macros_.size()));
-            macros_.push_back(m);
-        }
-        active_.assign(macros_.size(), 0);
-        // Which raw identifiers name a macro: one look-up per token, whatever expands.
-        macroAt_.assign(raw_.size(), kNotMacro);
-        if (macros_.empty()) return;
-        for (size_t i = 0; i < raw_.size(); ++i) {
-            if (raw_[i].kind != Tok::Ident) continue;
-            auto it = byName_.find(spelling(src_, raw_[i]));
-            if (it != byName_.end()) macroAt_[i] = it->second;
-        }
-    }
-
-    size_t skipLine(size_t i) const {
-        while (i < raw_.size() - 1 && !(raw_[i].flags & kLineStart)) ++i;
-        return i;
-    }
-
-    // The index just past the '}' matching the '{' at i, or 0 when it is not closed.
-    size_t matchBrace(size_t i) const {
-        size_t depth = 0;
-        for (size_t k = i; k < raw_.size() - 1; ++k) {
-            if (raw_[k].kind == Tok::LBrace)
-                ++depth;
-            else if (raw_[k].kind == Tok::RBrace && --depth == 0)
-                return k + 1;
-            else if (raw_[k].kind == Tok::Hash && (raw_[k].flags & kLineStart))
-                return 0;
-        }
-        return 0;
-    }
-
-    // #define NAME body. Returns the raw index after it.
-    size_t directive(size_t i) {
-        const Token& hash = raw_[i];
-        if (!(hash.flags & kLineStart)) {
-            error(hash, "'#' must be the first thing on its line");
-            return skipLine(i + 1);
-        }
-        if (!sameLine(i + 1) || spelling(src_, raw_[i + 1]) != "define") {
-            if (sameLine(i + 1))
-                error(raw_[i + 1], fmt::format("unknown directive '#{}': only #define is supported",
-                                               clip(spelling(src_, raw_[i + 1]))));
-            else
-                error(hash, "expected 'define' after '#'");
-            return skipLine(i + 1);
-        }
-        if (!sameLine(i + 2) ||
-            (raw_[i + 2].kind != Tok::Ident && raw_[i + 2].kind != Tok::Keyword)) {
-            error(sameLine(i + 2) ? raw_[i + 2] : raw_[i + 1],
-                  "expected a macro name after #define");
-            return skipLine(i + 2);
-        }
-        const Token& nameTok = raw_[i + 2];
-        const std::string_view name = spelling(src_, nameTok);
-        if (nameTok.kind == Tok::Keyword) {
-            error(nameTok, fmt::format("'{}' is a keyword and cannot be a macro name", clip(name)));
-            return skipLine(i + 3);
-        }
-        // The body.
-        size_t begin = i + 3, end = begin, next = begin;
-        if (sameLine(begin)) {
-            const size_t lineEnd = skipLine(begin);
-            if (raw_[begin].kind == Tok::LBrace) {
-                const size_t close = matchBrace(begin);
-                if (close == 0) {
-                    error(raw_[begin],
-                          fmt::format("the '{{' of #define {} is never closed", clip(name)));
-                    stop_ = true;
-                    return raw_.size() - 1;
-                }
-                if (close > lineEnd && sameLine(close)) {
-                    error(raw_[close], fmt::format("unexpected {} after the block of #define {}",
-                                                   describe(src_, raw_[close]), clip(name)));
-                    end = close;
-                    next = skipLine(close);
-                } else {
-                    end = next = std::max(close, lineEnd);
-                }
-            } else {
-                end = next = lineEnd;
-            }
-        } else if (begin < raw_.size() - 1 && raw_[begin].kind == Tok::LBrace) {
-            // The paper's figure 8: the name alone, the block on the following lines.
-            const size_t close = matchBrace(begin);
-            if (close == 0) {
-                error(raw_[begin],
-                      fmt::format("the '{{' of #define {} is never closed", clip(name)));
-                stop_ = true;
-                return raw_.size() - 1;
-            }
-            end = close;
-            next = close;
-            if (sameLine(close)) {
-                error(raw_[close], fmt::format("unexpected {} after the block of #define {}",
-                                               describe(src_, raw_[close]), clip(name)));
-                next = skipLine(close);
-            }
-        }
-        const uint32_t index = byName_.at(name);
-        Macro& m = macros_[index];
-        if (m.hash != i) {
-            error(nameTok, fmt::format("macro '{}' is already defined at line {}", clip(name),
-                                       src_.loc(raw_[m.hash].offset).line));
-            return next;
-        }
-        for (size_t k = begin; k < end; ++k) {
-            if (raw_[k].kind == Tok::Hash) {
-                error(raw_[k], fmt::format("'#' inside the body of #define {}", clip(name)));
-                end = k;
-                break;
-            }
-            if (raw_[k].kind == Tok::Ident && spelling(src_, raw_[k]) == name && !m.reported) {
-                error(raw_[k], fmt::format("macro '{}' expands into itself", clip(name)));
-                m.reported = true;
-            }
-        }
-        m.bodyBegin = static_cast<uint32_t>(begin);
-        m.bodyEnd = static_cast<uint32_t>(end);
-        m.defined = true;
-        return next;
-    }
-
-    void emit(Token t) {
-        if (out_.size() >= raw_.size() + kMaxExpansionTokens) {
-            if (!stop_)
-                error(t, fmt::format("macro expansion makes more than {} tokens", out_.size()));
-            stop_ = true;
-            return;
-        }
-        out_.push_back(t);
-    }
-
-    // Expands one use of a macro, iteratively (a chain of macros never deepens the stack).
-    void use(uint32_t index, const Token& at, bool lineStart) {
-        // A macro that cannot expand here is reported and dropped: leaving its name
-        // would only add echoes ("unknown module ...") of the same error.
-        if (!usable(index, at)) return;
-        frames_.clear();
-        push(index, lineStart);
-        while (!frames_.empty() && !stop_) {
-            Frame& f = frames_.back();
-            const Macro& m = macros_[f.macro];
-            if (f.pos >= m.bodyEnd) {
-                active_[f.macro] = 0;
-                frames_.pop_back();
-                continue;
-            }
-            const uint32_t rawIndex = f.pos;
-            Token t = raw_[f.pos];
-            const bool first = f.pos == m.bodyBegin;
-            ++f.pos;
-            const bool ls = first ? f.lineStart : (t.flags & kLineStart) != 0;
-            t.flags = static_cast<uint8_t>((t.flags & ~kLineStart) | (ls ? kLineStart : 0));
-            const uint32_t inner = macroAt_[rawIndex];
-            if (inner != kNotMacro) {
-                if (usable(inner, t)) push(inner, ls);  // invalidates f
-                continue;
-            }
-            emit(t);
-        }
-        for (const Frame& f : frames_) active_[f.macro] = 0;
-        frames_.clear();
-    }
-
-    // Whether a macro may be expanded here; reports why not.
-    bool usable(uint32_t index, const Token& at) {
-        Macro& m = macros_[index];
-        if (!m.defined) {
-            error(at, fmt::format("macro '{}' is used before its #define at line {}", clip(m.name),
-                                  src_.loc(raw_[m.hash].offset).line));
-            return false;
-        }
-        if (active_[index]) {
-            if (!m.reported) error(at, fmt::format("macro '{}' expands into itself", clip(m.name)));
-            m.reported = true;
-            return false;
-        }
-        return true;
-    }
-
-    void push(uint32_t index, bool lineStart) {
-        active_[index] = 1;
-        frames_.push_back(Frame{index, macros_[index].bodyBegin, lineStart});
-    }
-
-    const Source& src_;
-    Diagnostics& diags_;
-    const std::vector<Token>& raw_;
-    std::vector<Token>& out_;
-    std::vector<Macro> macros_;
-    std::unordered_map<std::string_view, uint32_t> byName_;
-    static constexpr uint32_t kNotMacro = UINT32_MAX;
-    std::vector<uint32_t> macroAt_;  // raw index -> macro, or kNotMacro
-    std::vector<uint8_t> active_;
-    std::vector<Frame> frames_;
     bool stop_ = false;
 };
 
@@ -861,18 +551,16 @@ TokenStream lex(const Source& src, Diagnostics& diags) {
 
     TokenStream ts;
     ts.complete = !scanner.stopped();
-    const bool macros =
+    const bool hasDirectives =
         std::any_of(raw.begin(), raw.end(), [](const Token& t) { return t.kind == Tok::Hash; });
-    std::vector<Token> expanded;
-    if (macros) {
-        Expander expander(src, diags, raw, expanded);
-        expander.run();
-        ts.complete = ts.complete && !expander.stopped();
+    std::vector<Token> afterMacros;
+    if (hasDirectives) {
+        ts.complete = expandMacros(src, diags, raw, afterMacros) && ts.complete;
         std::vector<Token>().swap(raw);
     } else {
-        expanded.swap(raw);
+        afterMacros.swap(raw);
     }
-    applyNewlineRule(expanded, ts.tokens);
+    applyNewlineRule(afterMacros, ts.tokens);
     return ts;
 }
 

@@ -3,7 +3,7 @@
 // Three steps, each linear in the input:
 //  1. scan: bytes -> raw tokens (comments and blanks dropped, each token knowing whether
 //     it is the first on its line);
-//  2. #define: collect the object-like macros and expand them as tokens;
+//  2. #define (macros.h): collect the object-like macros and expand their uses as tokens;
 //  3. the newline rule: insert a Newline token where a line break ends a statement (or
 //     separates items inside `{ }`), so the parser never looks at line breaks itself.
 //
@@ -161,7 +161,7 @@ struct TokenStream {
     bool complete = true;
 };
 
-// Lexes and expands `src`. Errors go to `diags`; the stream is usable (ends with End)
+// Lexes `src` and expands its macros. Errors go to `diags`; the stream is usable (ends with End)
 // even then, so that the parser can report more errors.
 TokenStream lex(const Source& src, Diagnostics& diags);
 
