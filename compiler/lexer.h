@@ -157,12 +157,12 @@ struct Token {
 struct TokenStream {
     std::vector<Token> tokens;  // always ends with Tok::End
     // False when lexing stopped early (a NUL byte, an unterminated comment or #define
-    // block, a runaway expansion): the tokens are then only a prefix of the file.
+    // block, a runaway macro expansion): the tokens are then only a prefix of the file.
     bool complete = true;
 };
 
-// Lexes `src` and expands its macros. Errors go to `diags`; the stream is usable (ends with End)
-// even then, so that the parser can report more errors.
+// Lexes `src` and expands its macros. Errors go to `diags`; the stream is usable (ends
+// with End) even then, so that the parser can report more errors.
 TokenStream lex(const Source& src, Diagnostics& diags);
 
 // The spelling of a token ("end of line" for a Newline): for messages.
@@ -177,6 +177,6 @@ std::string_view keywordName(Kw k);
 // Size limits (docs/language.md section 8: never crash or hang, whatever the input).
 inline constexpr size_t kMaxSourceBytes = size_t(256) << 20;  // 256 MB
 // Macro expansion may add at most this many tokens to a file's own.
-inline constexpr size_t kMaxExpansionTokens = size_t(1) << 20;
+inline constexpr size_t kMaxMacroTokens = size_t(1) << 20;
 
 }  // namespace pcsg

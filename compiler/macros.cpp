@@ -228,7 +228,7 @@ class MacroProcessor {
     }
 
     void emit(Token t) {
-        if (out_.size() >= raw_.size() + kMaxExpansionTokens) {
+        if (out_.size() >= raw_.size() + kMaxMacroTokens) {
             if (!stop_)
                 error(t, fmt::format("macro expansion makes more than {} tokens", out_.size()));
             stop_ = true;
