@@ -16,7 +16,7 @@ if [[ $mode != run && $mode != test ]]; then
     exit 2
 fi
 
-PACKAGES=(build-essential cmake ninja-build pkg-config libfmt-dev libcli11-dev
+PACKAGES=(build-essential cmake ninja-build pkg-config libfmt-dev libcli11-dev libpng-dev
           nlohmann-json3-dev libopenimageio-dev openimageio-tools libtbb-dev libgtest-dev
           libgmock-dev libbenchmark-dev povray graphviz clang clang-format chromium)
 BUILD=build              # the binaryDir of the "release" preset in CMakePresets.json
@@ -58,7 +58,7 @@ install_missing() {
 install_missing
 cmake --preset release
 if [[ $mode == run ]]; then
-    # Builds pcsg-image too: pcsg depends on the helper that writes and compares images.
+    # Builds pcsg-image too: pcsg depends on the helper that writes EXR/TIFF and compares images.
     cmake --build "$BUILD" --target pcsg
     main_job
 else

@@ -28,6 +28,12 @@ TEST(BenchCommand, NativeOnlyJsonHasTheFiguresOfEachScene) {
     EXPECT_GT(s["native_peak_rss_bytes"].get<uint64_t>(), 0u);
     EXPECT_EQ(s["primitive_equivalence"].get<uint64_t>(), 4096u);  // order 6
     EXPECT_FALSE(s["povray_ok"].get<bool>());
+    // The targets that need no POV-Ray are judged, each with its verdict.
+    ASSERT_TRUE(j.contains("targets")) << r.out;
+    ASSERT_EQ(j["targets"].size(), 1u) << r.out;
+    EXPECT_NE(j["targets"][0]["target"].get<std::string>().find("order 8 whole render command"),
+              std::string::npos);
+    EXPECT_TRUE(j["targets"][0]["met"].is_boolean());
 }
 
 TEST(BenchCommand, SideBySideTableWithDateMachineAndTargets) {
@@ -45,6 +51,8 @@ TEST(BenchCommand, SideBySideTableWithDateMachineAndTargets) {
     EXPECT_NE(table.find("| sierpinski_8 | 4096 |"), std::string::npos) << table;
     EXPECT_NE(table.find("order 8 at least 3x faster than POV-Ray"), std::string::npos) << table;
     EXPECT_NE(table.find("order 8 peak RSS at most 1/20"), std::string::npos) << table;
+    EXPECT_NE(table.find("order 8 whole render command at most 22.0 MB"), std::string::npos)
+        << table;
     // Appending keeps what was there.
     ASSERT_EQ(pcsg({"bench", "--width", "48", "--height", "36", "--markdown", md, a}).exitCode, 0);
     EXPECT_EQ(readFile(md).substr(0, table.size()), table);

@@ -1,7 +1,7 @@
 // Comparing two renderings of one scene (`pcsg-image compare`, run by pcsg verify): both
 // images are decoded to linear floats, reduced by the same K×K box filter through
 // OpenImageIO, and compared in sRGB-encoded values, which is what a person sees. Part of
-// the pcsg_image library (with tools/image_io.h), the only code that links OpenImageIO.
+// the pcsg_image library (with tools/image/image_io.h), the only code that links OpenImageIO.
 #pragma once
 
 #include <OpenImageIO/imagebuf.h>

@@ -1,7 +1,7 @@
 // The colour ramp of verify's difference heat map, in one place for both of its users:
 // `pcsg-image compare --heatmap` draws diff.png with heatColour() (image_compare.cpp),
-// and the report's legend (verify_command.cpp) draws its CSS gradient and its ticks from
-// the same stops, so the legend always says what the picture shows. No OpenImageIO here.
+// and the report's legend (tools/report/verify_report.cpp) draws its CSS gradient and its ticks
+// from the same stops, so the legend always says what the picture shows. No OpenImageIO here.
 #pragma once
 
 #include <fmt/format.h>

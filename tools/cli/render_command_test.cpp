@@ -1,9 +1,9 @@
-// `pcsg render` run as a program: it renders in its own process and has pcsg-image write
-// the file, so the image must come out whole (size, and the same pixels whichever format
-// carries them), a scene with a run-time error must leave no image, and a missing
-// helper must be named. The helper starts before the render (its start-up overlaps it):
-// a scene that does not compile starts none, one that fails at run time stops it without
-// a word from it, and no exit leaves a helper process behind.
+// `pcsg render` run as a program: it writes a PNG itself and has pcsg-image write an EXR
+// or TIFF file, so the image must come out whole (size, and the same pixels whichever
+// format carries them), a scene with a run-time error must leave no image, and a missing
+// helper must be named when one is needed. The helper runs only once the pixels exist:
+// a scene that does not compile or fails at run time starts none, a PNG render never
+// does, and no exit leaves a helper process behind.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/inotify.h>
@@ -136,13 +136,36 @@ TEST(RenderCommand, WritesAPngOfTheRightSize) {
     // Not a blank image: the background and the object are both there.
     ASSERT_FALSE(px.empty());
     EXPECT_NE(*std::min_element(px.begin(), px.end()), *std::max_element(px.begin(), px.end()));
-    // The render's own peak RSS, and the writer's beside it.
+    // The whole command's peak RSS; no writer process for a PNG.
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_GT(j.value("peak_rss_bytes", uint64_t{0}), 0u);
-    EXPECT_GT(j.value("image_writer_peak_rss_bytes", uint64_t{0}), 0u);
+    EXPECT_TRUE(j.contains("image_write_seconds"));
+    EXPECT_FALSE(j.contains("image_writer_peak_rss_bytes"));
+    EXPECT_FALSE(j.contains("image_writer_seconds"));
+    EXPECT_EQ(filesIn(dir.path()), (std::vector<std::string>{"s.pcsg", "s.png"}));
+    EXPECT_EQ(subreaper.leftovers(), 0);
+}
+
+TEST(RenderCommand, AnExrIsWrittenByTheHelperWhosePeakIsTheCommands) {
+    Subreaper subreaper;
+    TempDir dir;
+    const std::string scene = dir.write("s.pcsg", kScene);
+    const std::string out = dir.file("s.exr");
+    const ChildResult r =
+        pcsg({"render", scene, "-o", out, "--width", "40", "--height", "30", "--json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    OIIO::ImageSpec spec;
+    readBack<float>(out, OIIO::TypeDesc::FLOAT, spec);
+    EXPECT_EQ(spec.width, 40);
+    EXPECT_EQ(spec.height, 30);
+    // The writer's peak RSS beside the whole command's, which includes it.
+    const auto j = nlohmann::json::parse(r.out);
+    const uint64_t writer = j.value("image_writer_peak_rss_bytes", uint64_t{0});
+    EXPECT_GT(writer, 0u);
+    EXPECT_GE(j.value("peak_rss_bytes", uint64_t{0}), writer);
     EXPECT_TRUE(j.contains("image_write_seconds"));
     EXPECT_TRUE(j.contains("image_writer_seconds"));
-    EXPECT_EQ(filesIn(dir.path()), (std::vector<std::string>{"s.pcsg", "s.png"}));
+    EXPECT_EQ(filesIn(dir.path()), (std::vector<std::string>{"s.exr", "s.pcsg"}));
     EXPECT_EQ(subreaper.leftovers(), 0);
 }
 
@@ -175,7 +198,7 @@ const char* kRunTimeError =
 
 TEST(RenderCommand, ARunTimeErrorExitsOneAndWritesNothing) {
     // Found by the primitive count before the render, and (the count stopped at once) by
-    // the render itself: either way the writer, started before both, is stopped silently.
+    // the render itself: either way no image and no writer.
     for (const char* countVisits : {"20000000", "0"}) {
         SCOPED_TRACE(std::string("--count-visits ") + countVisits);
         Subreaper subreaper;
@@ -186,8 +209,7 @@ TEST(RenderCommand, ARunTimeErrorExitsOneAndWritesNothing) {
                                     "--count-visits", countVisits});
         EXPECT_EQ(r.exitCode, 1) << r.err;
         EXPECT_EQ(r.signal, 0);
-        // Exactly the one error, with its module path; nothing from pcsg-image (whose
-        // input ended unwritten).
+        // Exactly the one error, with its module path; nothing from pcsg-image.
         EXPECT_EQ(occurrences(r.err, "error"), 1u) << r.err;
         EXPECT_EQ(r.err.rfind(scene + ":2:3: error: the selection function of module S", 0), 0u)
             << r.err;
@@ -199,19 +221,19 @@ TEST(RenderCommand, ARunTimeErrorExitsOneAndWritesNothing) {
     }
 }
 
-TEST(RenderCommand, ARunTimeErrorSilencesAWriterThatComplained) {
-    // This writer complains before it even reads its input; the user must not see it.
+TEST(RenderCommand, ARunTimeErrorStartsNoWriter) {
+    // This writer would complain; for an EXR that fails at run time it never runs.
     Subreaper subreaper;
     TempDir dir;
     HelperBeside helper(dir, "echo 'pcsg-image write: a complaint' >&2");
     const std::string scene = dir.write("bad.pcsg", kRunTimeError);
     const ChildResult r = helper.pcsg(
-        {"render", scene, "-o", dir.file("bad.png"), "--width", "16", "--height", "12"});
+        {"render", scene, "-o", dir.file("bad.exr"), "--width", "16", "--height", "12"});
     EXPECT_EQ(r.exitCode, 1) << r.err;
-    EXPECT_TRUE(helper.started());  // before the render: it was there to be stopped
+    EXPECT_FALSE(helper.started());
     EXPECT_EQ(occurrences(r.err, "error"), 1u) << r.err;
     EXPECT_EQ(r.err.find("complaint"), std::string::npos) << r.err;
-    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.png")));
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
     EXPECT_EQ(subreaper.leftovers(), 0);
 }
 
@@ -220,27 +242,34 @@ TEST(RenderCommand, ACompileErrorStartsNoWriter) {
     TempDir dir;
     HelperBeside helper(dir, "");
     const ChildResult bad =
-        helper.pcsg({"render", dir.write("bad.pcsg", "sphere ∪\n"), "-o", dir.file("bad.png")});
+        helper.pcsg({"render", dir.write("bad.pcsg", "sphere ∪\n"), "-o", dir.file("bad.exr")});
     EXPECT_EQ(bad.exitCode, 1) << bad.err;
     EXPECT_NE(bad.err.find("error"), std::string::npos) << bad.err;
     EXPECT_FALSE(helper.started());
-    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.png")));
-    // The watch does see a start: a scene that compiles runs the helper.
-    const ChildResult good = helper.pcsg({"render", dir.write("s.pcsg", kScene), "-o",
-                                          dir.file("s.png"), "--width", "16", "--height", "12"});
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
+    // A PNG that renders is written without the helper too.
+    const std::string scene = dir.write("s.pcsg", kScene);
+    const ChildResult png =
+        helper.pcsg({"render", scene, "-o", dir.file("s.png"), "--width", "16", "--height", "12"});
+    EXPECT_EQ(png.exitCode, 0) << png.err;
+    EXPECT_FALSE(helper.started());
+    EXPECT_TRUE(std::filesystem::exists(dir.file("s.png")));
+    // The watch does see a start: an EXR of a scene that renders runs the helper.
+    const ChildResult good =
+        helper.pcsg({"render", scene, "-o", dir.file("s.exr"), "--width", "16", "--height", "12"});
     EXPECT_EQ(good.exitCode, 0) << good.err;
     EXPECT_TRUE(helper.started());
-    EXPECT_TRUE(std::filesystem::exists(dir.file("s.png")));
+    EXPECT_TRUE(std::filesystem::exists(dir.file("s.exr")));
     EXPECT_EQ(subreaper.leftovers(), 0);
 }
 
 TEST(RenderCommand, AWriterThatDiesBeforeReadingIsAnError) {
-    // The writer is gone long before the pixels are ready: writing them must fail with
-    // EPIPE, not kill pcsg with SIGPIPE, and what the writer said is the error.
+    // The writer is gone before it reads the pixels: writing them must fail with EPIPE,
+    // not kill pcsg with SIGPIPE, and what the writer said is the error.
     Subreaper subreaper;
     TempDir dir;
     HelperBeside helper(dir, "echo 'pcsg-image: out of order' >&2; exit 3");
-    const std::string out = dir.file("s.png");
+    const std::string out = dir.file("s.exr");
     const ChildResult r = helper.pcsg(
         {"render", dir.write("s.pcsg", kScene), "-o", out, "--width", "16", "--height", "12"});
     EXPECT_EQ(r.signal, 0);
@@ -259,28 +288,42 @@ TEST(RenderCommand, AMissingImageHelperIsNamed) {
     std::filesystem::permissions(lonely, std::filesystem::perms::owner_exec,
                                  std::filesystem::perm_options::add);
     const std::string scene = dir.write("s.pcsg", kScene);
-    const std::string out = dir.file("s.png");
+    for (const char* name : {"s.exr", "s.tif"}) {
+        const std::string out = dir.file(name);
+        const ChildResult r = runChild({"env", "PATH=" + dir.file("empty-bin"), lonely, "render",
+                                        scene, "-o", out, "--width", "16", "--height", "12"});
+        ASSERT_TRUE(r.started);
+        EXPECT_EQ(r.exitCode, 2) << r.err;
+        EXPECT_NE(r.err.find("pcsg-image is missing"), std::string::npos) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(out));
+    }
+    // A PNG needs no helper.
+    const std::string png = dir.file("s.png");
     const ChildResult r = runChild({"env", "PATH=" + dir.file("empty-bin"), lonely, "render", scene,
-                                    "-o", out, "--width", "16", "--height", "12"});
-    ASSERT_TRUE(r.started);
-    EXPECT_EQ(r.exitCode, 2) << r.err;
-    EXPECT_NE(r.err.find("pcsg-image is missing"), std::string::npos) << r.err;
-    EXPECT_FALSE(std::filesystem::exists(out));
+                                    "-o", png, "--width", "16", "--height", "12"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(png));
 }
 
 TEST(RenderCommand, AnUnwritableOutputIsAnError) {
     Subreaper subreaper;
     TempDir dir;
     const std::string scene = dir.write("s.pcsg", kScene);
-    const std::string out = dir.file("missing/s.png");
-    const ChildResult r = pcsg({"render", scene, "-o", out, "--width", "16", "--height", "12"});
-    EXPECT_EQ(r.exitCode, 2);
-    // One line, the writer's reason under pcsg render's name.
-    EXPECT_EQ(r.err.rfind("pcsg render: pcsg-image write: cannot write '" + out + "': ", 0), 0u)
-        << r.err;
-    EXPECT_EQ(occurrences(r.err, "\n"), 1u) << r.err;
-    EXPECT_EQ(r.out, "");
-    EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"s.pcsg"});
+    // One line, the writer's reason under pcsg render's name: the PNG writer's own, and
+    // pcsg-image's for an EXR.
+    for (const auto& [name, writer] :
+         {std::pair{"missing/s.png", ""}, std::pair{"missing/s.exr", "pcsg-image write: "}}) {
+        const std::string out = dir.file(name);
+        const ChildResult r = pcsg({"render", scene, "-o", out, "--width", "16", "--height", "12"});
+        EXPECT_EQ(r.exitCode, 2);
+        EXPECT_EQ(
+            r.err.rfind(std::string("pcsg render: ") + writer + "cannot write '" + out + "': ", 0),
+            0u)
+            << r.err;
+        EXPECT_EQ(occurrences(r.err, "\n"), 1u) << r.err;
+        EXPECT_EQ(r.out, "");
+        EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"s.pcsg"});
+    }
     EXPECT_EQ(subreaper.leftovers(), 0);
 }
 

@@ -2,13 +2,14 @@
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
+
+#include "png_writer.h"
 
 namespace pcsg::tools {
 
@@ -28,17 +29,12 @@ void writeImage(const std::string& path, int width, int height, std::span<const 
             fmt::format("cannot write '{}': {} values for a {}x{} RGB image (expected {})", path,
                         rgb.size(), width, height, n));
 
+    // The one 8-bit sRGB encoder, also pcsg render's own.
+    if (*format == ImageFormat::png) return writePng(path, width, height, rgb);
     OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT;
-    std::vector<uint8_t> bytes8;
     std::vector<uint16_t> bytes16;
     const void* data = rgb.data();
-    if (*format == ImageFormat::png) {
-        type = OIIO::TypeDesc::UINT8;
-        bytes8.resize(n);
-        for (size_t i = 0; i < n; ++i)
-            bytes8[i] = static_cast<uint8_t>(std::lround(srgbEncode(rgb[i]) * 255.0));
-        data = bytes8.data();
-    } else if (*format == ImageFormat::tiff) {
+    if (*format == ImageFormat::tiff) {
         type = OIIO::TypeDesc::UINT16;
         bytes16.resize(n);
         for (size_t i = 0; i < n; ++i)
@@ -47,9 +43,7 @@ void writeImage(const std::string& path, int width, int height, std::span<const 
     }
 
     const fs::path target(path);
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    const std::string ext = target.extension().string();
-    const fs::path tmp = dir / fmt::format(".{}.tmp{}{}", target.stem().string(), getpid(), ext);
+    const fs::path tmp = temporaryBeside(target);
     // Every failure removes the temporary file (OpenImageIO may have created it).
     auto fail = [&](const std::string& why) {
         std::error_code ec;

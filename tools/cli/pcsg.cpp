@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
     pcsg::tools::addCheckCommand(app, status);
     pcsg::tools::addGraphCommand(app, status);
     pcsg::tools::addRenderCommand(app, status);
-    pcsg::tools::addExportCommands(app, status);
+    pcsg::tools::addExportCommand(app, status);
+    pcsg::tools::addStatsCommand(app, status);
     pcsg::tools::addVerifyCommand(app, status);
     pcsg::tools::addBenchCommand(app, status);
     try {

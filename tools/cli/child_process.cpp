@@ -81,9 +81,35 @@ class SigpipeBlock {
     bool pendingBefore_ = false, raised_ = false;
 };
 
-}  // namespace
+// A child process with pipes to its standard streams (its input a pipe, or /dev/null),
+// run to its end by runChild(): started, fed while its output is read (so that neither
+// side can block the other for good), then reaped.
+class Child {
+  public:
+    Child(const std::vector<std::string>& argv, bool withInput);
+    ~Child();
+    Child(const Child&) = delete;
+    Child& operator=(const Child&) = delete;
 
-AsyncChild::AsyncChild(const std::vector<std::string>& argv, Input input) {
+    // Writes `data` to the child's standard input, reading its output meanwhile, until all
+    // of it is written or the child takes no more; then closes its input.
+    void feed(std::span<const std::byte> data);
+    // Reads the child's output to its end and reaps it.
+    ChildResult wait();
+
+  private:
+    void readOutput(int& fd, std::string& into);
+    bool pump(bool writing, std::span<const std::byte> data, size_t& written);
+    ChildResult reap();
+
+    std::string program_;
+    pid_t pid_ = -1;
+    int in_ = -1, out_ = -1, err_ = -1;  // this process's ends of the pipes
+    std::chrono::steady_clock::time_point start_;
+    ChildResult result_;
+};
+
+Child::Child(const std::vector<std::string>& argv, bool withInput) {
     start_ = std::chrono::steady_clock::now();
     if (argv.empty()) return;
     program_ = argv[0];
@@ -94,7 +120,7 @@ AsyncChild::AsyncChild(const std::vector<std::string>& argv, Input input) {
             closeFd(p[1]);
         }
     };
-    if ((input == Input::Pipe && !makePipe(inPipe)) || !makePipe(outPipe) || !makePipe(errPipe)) {
+    if ((withInput && !makePipe(inPipe)) || !makePipe(outPipe) || !makePipe(errPipe)) {
         closeAll();
         return;
     }
@@ -104,7 +130,7 @@ AsyncChild::AsyncChild(const std::vector<std::string>& argv, Input input) {
     // and closing ours is the end of the child's input.
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    if (input == Input::Pipe)
+    if (withInput)
         posix_spawn_file_actions_adddup2(&actions, inPipe[0], 0);
     else
         posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
@@ -137,7 +163,7 @@ AsyncChild::AsyncChild(const std::vector<std::string>& argv, Input input) {
         closeAll();
         return;
     }
-    started_ = true;
+    result_.started = true;
     pid_ = pid;
     in_ = inPipe[1];
     out_ = outPipe[0];
@@ -146,14 +172,14 @@ AsyncChild::AsyncChild(const std::vector<std::string>& argv, Input input) {
         if (fd >= 0) setNonBlocking(fd);
 }
 
-AsyncChild::~AsyncChild() {
-    if (pid_ > 0) abandon();
+Child::~Child() {
     closeFd(in_);
     closeFd(out_);
     closeFd(err_);
+    if (pid_ > 0) reap();  // a child is never left unreaped
 }
 
-void AsyncChild::readOutput(int& fd, std::string& into) {
+void Child::readOutput(int& fd, std::string& into) {
     char buffer[65536];
     const ssize_t n = read(fd, buffer, sizeof buffer);
     if (n > 0)
@@ -166,7 +192,7 @@ void AsyncChild::readOutput(int& fd, std::string& into) {
 // all of it is written or the child takes no more. Without: reads the child's output to
 // its end. Either way it reads whatever output comes meanwhile, so a child blocked on a
 // full output pipe cannot block the writing. Returns whether a write hit a closed pipe.
-bool AsyncChild::pump(bool writing, std::span<const std::byte> data, size_t& written) {
+bool Child::pump(bool writing, std::span<const std::byte> data, size_t& written) {
     bool brokenPipe = false;
     for (;;) {
         const bool wantWrite = writing && in_ >= 0 && written < data.size();
@@ -189,7 +215,7 @@ bool AsyncChild::pump(bool writing, std::span<const std::byte> data, size_t& wri
         if (poll(fds, n, -1) < 0) {
             if (errno == EINTR) continue;
             // Only with bad descriptors, which these are not; give up rather than spin.
-            closeInput();
+            closeFd(in_);
             closeFd(out_);
             closeFd(err_);
             break;
@@ -205,44 +231,31 @@ bool AsyncChild::pump(bool writing, std::span<const std::byte> data, size_t& wri
             } else {
                 // EPIPE: the child has exited or closed its input; it takes no more.
                 brokenPipe = brokenPipe || (k < 0 && errno == EPIPE);
-                closeInput();
+                closeFd(in_);
             }
         }
     }
     return brokenPipe;
 }
 
-size_t AsyncChild::feed(std::span<const std::byte> data) {
-    if (in_ < 0 || data.empty()) return 0;
-    SigpipeBlock block;
-    size_t written = 0;
-    if (pump(true, data, written)) block.raised();
-    result_.inputWritten += written;
-    return written;
-}
-
-void AsyncChild::closeInput() {
+void Child::feed(std::span<const std::byte> data) {
+    if (in_ >= 0 && !data.empty()) {
+        SigpipeBlock block;
+        size_t written = 0;
+        if (pump(true, data, written)) block.raised();
+        result_.inputWritten += written;
+    }
     closeFd(in_);
 }
 
-ChildResult AsyncChild::wait() {
-    closeInput();
+ChildResult Child::wait() {
+    closeFd(in_);
     size_t none = 0;
     pump(false, {}, none);
-    return reap(true);
+    return reap();
 }
 
-ChildResult AsyncChild::abandon() {
-    closeInput();
-    closeFd(out_);
-    closeFd(err_);
-    // The child is not reaped yet, so its pid is still its own (a zombie's at worst, which
-    // the signal does not harm).
-    if (pid_ > 0) kill(pid_, SIGKILL);
-    return reap(false);
-}
-
-ChildResult AsyncChild::reap(bool keepOutput) {
+ChildResult Child::reap() {
     if (pid_ <= 0) return result_;  // never started, or reaped already
     int status = 0;
     rusage usage{};
@@ -253,10 +266,6 @@ ChildResult AsyncChild::reap(bool keepOutput) {
     result_.started = true;
     result_.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    if (!keepOutput) {
-        result_.out.clear();
-        result_.err.clear();
-    }
     if (got < 0) return result_;  // someone else reaped it (SIGCHLD ignored): status unknown
     result_.peakRssBytes = static_cast<uint64_t>(usage.ru_maxrss) * 1024;
     if (WIFEXITED(status)) {
@@ -270,13 +279,15 @@ ChildResult AsyncChild::reap(bool keepOutput) {
     return result_;
 }
 
+}  // namespace
+
 ChildResult runChild(const std::vector<std::string>& argv) {
-    AsyncChild child(argv, AsyncChild::Input::DevNull);
+    Child child(argv, false);
     return child.wait();
 }
 
 ChildResult runChild(const std::vector<std::string>& argv, std::span<const std::byte> input) {
-    AsyncChild child(argv);
+    Child child(argv, true);
     child.feed(input);
     return child.wait();
 }

@@ -1,7 +1,8 @@
-// Image files through the pcsg-image helper (tools/pcsg_image.cpp). pcsg itself does not
-// link OpenImageIO, whose ~260 shared libraries would cost every process ~130 MB of peak
-// RSS and half a second of start-up: `pcsg render` pipes its linear float pixels to
-// `pcsg-image write`, and `pcsg verify` runs `pcsg-image compare`.
+// What pcsg asks of the pcsg-image helper (tools/image/pcsg_image.cpp), run to its end
+// as a process of its own. pcsg itself does not link OpenImageIO, whose ~260 shared
+// libraries would cost every process ~130 MB of peak RSS and half a second of start-up:
+// `pcsg render` writes a PNG itself (png_writer.h) but pipes an EXR's or TIFF's linear
+// float pixels to `pcsg-image write`, and `pcsg verify` runs `pcsg-image compare`.
 #pragma once
 
 #include <cstdint>
@@ -28,36 +29,11 @@ struct ImageWriteResult {
     bool ok = false;
     std::string error;          // why not, as the helper said it (one or more lines)
     uint64_t peakRssBytes = 0;  // the helper process's
-    // Wall time from the first byte of the pixels to the helper's exit: what the caller
-    // waited for once it had the pixels (the piping, the encoding, and whatever of the
-    // helper's start-up was still going on).
-    double seconds = 0;
-    double helperSeconds = 0;  // the helper's whole wall time, from its start
-};
-
-// `pcsg-image write PATH WIDTH HEIGHT`, started before the pixels exist so that its
-// start-up (loading OpenImageIO's shared libraries, about half a second) overlaps the
-// work that makes them; it then waits on its standard input. Either finish() gives it
-// the pixels, or abandon() (or the destructor) stops it.
-class ImageWriter {
-  public:
-    ImageWriter(const std::string& helper, const std::string& path, int width, int height);
-
-    // Pipes the pixels (linear RGB floats, row-major from the top-left) to the helper and
-    // waits for it to write the file.
-    ImageWriteResult finish(std::span<const float> rgb);
-
-    // No image after all: the helper, which cannot have written anything without its
-    // input, is killed and reaped, and what it said is dropped (so its complaint about a
-    // truncated input never reaches the user).
-    void abandon();
-
-  private:
-    AsyncChild child_;
+    double seconds = 0;         // the helper's wall time, start-up included
 };
 
 // `pcsg-image write PATH WIDTH HEIGHT` with the pixels (linear RGB floats, row-major from
-// the top-left) on its standard input: ImageWriter's start and finish() at once.
+// the top-left) on its standard input, for an EXR or TIFF file; waits for it to finish.
 ImageWriteResult writeImageWithHelper(const std::string& helper, const std::string& path, int width,
                                       int height, std::span<const float> rgb);
 

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <filesystem>
 
 namespace pcsg::tools {
@@ -46,16 +45,12 @@ std::string missingImageHelperMessage() {
         kImageHelperName, self.string(), kImageHelperName);
 }
 
-ImageWriter::ImageWriter(const std::string& helper, const std::string& path, int width, int height)
-    : child_({helper, "write", path, std::to_string(width), std::to_string(height)}) {}
-
-ImageWriteResult ImageWriter::finish(std::span<const float> rgb) {
+ImageWriteResult writeImageWithHelper(const std::string& helper, const std::string& path, int width,
+                                      int height, std::span<const float> rgb) {
     ImageWriteResult w;
-    const auto begin = std::chrono::steady_clock::now();
-    child_.feed(std::as_bytes(rgb));
-    const ChildResult c = child_.wait();
-    w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    w.helperSeconds = c.seconds;
+    const ChildResult c = runChild(
+        {helper, "write", path, std::to_string(width), std::to_string(height)}, std::as_bytes(rgb));
+    w.seconds = c.seconds;
     w.peakRssBytes = c.peakRssBytes;
     w.ok = c.started && c.exitCode == 0;
     if (w.ok && c.inputWritten != rgb.size_bytes()) {
@@ -68,15 +63,6 @@ ImageWriteResult ImageWriter::finish(std::span<const float> rgb) {
         w.error = helperError(c);
     }
     return w;
-}
-
-void ImageWriter::abandon() {
-    child_.abandon();
-}
-
-ImageWriteResult writeImageWithHelper(const std::string& helper, const std::string& path, int width,
-                                      int height, std::span<const float> rgb) {
-    return ImageWriter(helper, path, width, height).finish(rgb);
 }
 
 ImageCompareRun compareImagesWithHelper(const std::string& helper, const std::string& a,

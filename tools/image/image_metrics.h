@@ -1,5 +1,5 @@
 // The result of comparing two images, without OpenImageIO: `pcsg-image compare` computes
-// it (tools/image_compare.h) and prints it as JSON; `pcsg verify` reads it back.
+// it (tools/image/image_compare.h) and prints it as JSON; `pcsg verify` reads it back.
 #pragma once
 
 #include <cmath>

@@ -20,7 +20,7 @@ struct Stats {
     std::optional<uint64_t> expandedNodes;         // all nodes of the expanded tree
     std::optional<uint64_t> graphBytes;            // the cyclic graph in memory
     std::optional<uint64_t> expandedBytes;         // the expanded tree in memory
-    std::optional<uint64_t> peakRssBytes;          // this process's peak resident set
+    std::optional<uint64_t> peakRssBytes;          // the command's peak resident set
     std::optional<double> seconds;                 // wall time of the main job
     std::optional<double> parseSeconds;            // compiling the scene
 
@@ -30,6 +30,9 @@ struct Stats {
 
 // This process's peak resident set size in bytes (from getrusage).
 uint64_t peakRssBytes();
+// The whole command's: the larger of this process's and that of any child it waited for
+// (RUSAGE_CHILDREN), which is what /usr/bin/time -v reports for it.
+uint64_t wholeCommandPeakRssBytes();
 // "12.3 MB", "1.2 GB", "512 B".
 std::string humanBytes(uint64_t bytes);
 

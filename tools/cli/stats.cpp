@@ -3,12 +3,20 @@
 #include <fmt/format.h>
 #include <sys/resource.h>
 
+#include <algorithm>
+
 namespace pcsg::tools {
 
 uint64_t peakRssBytes() {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     return static_cast<uint64_t>(usage.ru_maxrss) * 1024;  // Linux reports kilobytes
+}
+
+uint64_t wholeCommandPeakRssBytes() {
+    rusage children{};
+    getrusage(RUSAGE_CHILDREN, &children);
+    return std::max(peakRssBytes(), static_cast<uint64_t>(children.ru_maxrss) * 1024);
 }
 
 std::string humanBytes(uint64_t bytes) {

@@ -1,7 +1,10 @@
-// What both sides of the image pipe agree on, without OpenImageIO: the file types an
-// image may be written as, and the sRGB transfer function. `pcsg render` checks the
-// output's type before it renders; `pcsg-image` (tools/image_io.h) writes the file.
+// What every image writer agrees on, without OpenImageIO: the file types an image may be
+// written as, where it is written before it is renamed, and the sRGB transfer function.
+// `pcsg render` checks the output's type before it renders, then writes a PNG itself
+// (tools/image/png_writer.h) or has pcsg-image write an EXR or TIFF (image_io.h).
 #pragma once
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -28,6 +31,15 @@ inline std::optional<ImageFormat> imageFormatOf(const std::string& path) {
     if (ext == ".tif" || ext == ".tiff") return ImageFormat::tiff;
     if (ext == ".exr") return ImageFormat::exr;
     return std::nullopt;
+}
+
+// Where an image is written before it is renamed to `target`: a hidden file beside it
+// with this process's id, so that a failed write never leaves a partial image in place.
+inline std::filesystem::path temporaryBeside(const std::filesystem::path& target) {
+    const std::filesystem::path dir =
+        target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+    return dir / (("." + target.stem().string() + ".tmp") + std::to_string(getpid()) +
+                  target.extension().string());
 }
 
 // For error messages about an unknown type.

@@ -1,266 +1,21 @@
-// pcsg verify: render a scene natively (the cyclic graph) and with POV-Ray (the expanded
-// tree written by export-pov), diff the two images and report whether they agree, with
-// the memory and time each way took.
-//
-// Both renders run as child processes of this one, so that each one's peak RSS is its
-// own (wait4's rusage), and both run without anti-aliasing at K times the size; the two
-// images are then reduced by the same K×K box filter, so edge sampling is identical.
-// Reading, reducing and comparing the images is `pcsg-image compare`'s job (a process of
-// its own, the only one that loads OpenImageIO: tools/image_helper.h).
+#include "verify_report.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <ctime>
-#include <filesystem>
 #include <fstream>
-#include <iostream>
-#include <nlohmann/json.hpp>
-#include <set>
 #include <sstream>
 
-#include "child_process.h"
-#include "commands.h"
 #include "heat_ramp.h"
-#include "image_helper.h"
-#include "renders.h"
-#include "stats.h"
 
 namespace pcsg::tools {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-struct VerifyOptions {
-    std::vector<std::string> scenes;
-    std::string allDir;
-    int width = 320, height = 240, ss = 2;
-    int threads = 0;
-    std::string reportDir;
-    std::string povFile;  // use this POV-Ray file instead of exporting (tests of verify)
-    bool json = false;
-    bool keep = false;
-    Thresholds thresholds;
-    std::string imageHelper;  // pcsg-image
-};
-
-struct Side {
-    double seconds = 0;         // wall time of the render process
-    uint64_t peakRssBytes = 0;  // of the render process
-    std::optional<double> parseSeconds, traceSeconds;
-    std::optional<double> imageWriteSeconds;          // native: pcsg-image write's
-    std::optional<uint64_t> imageWriterPeakRssBytes;  // native: pcsg-image write's
-};
-
-struct SceneResult {
-    std::string scene, name;
-    int status = 2;  // 0 agree, 1 disagree, 2 could not run
-    std::string message;
-    ImageMetrics metrics;
-    Side native, povray;
-    std::optional<uint64_t> graphBytes, graphNodes, expandedBytes, expandedNodes, primitives;
-    std::optional<double> raysPerSecond;
-    std::string dir;      // where the images are, relative to the report root
-    std::string povFile;  // the POV-Ray scene: a file name in dir, or --pov's path
-    bool povInReport = false;
-    std::string source;  // the scene's text, for the report
-};
-
-// The scene's text for the report (up to 256 KB); empty when it cannot be read.
-std::string readSource(const std::string& scene) {
-    std::ifstream in(scene, std::ios::binary);
-    if (!in) return {};
-    std::string text(256 * 1024, '\0');
-    in.read(text.data(), std::streamsize(text.size()));
-    const bool more = in.gcount() == std::streamsize(text.size()) && in.peek() != EOF;
-    text.resize(size_t(in.gcount()));
-    if (more) text += "\n... (the rest is left out)\n";
-    return text;
-}
-
-// Verifies one scene, writing its images into root/dir.
-SceneResult verifyScene(const std::string& scene, const std::string& dir, const VerifyOptions& o,
-                        const fs::path& root) {
-    SceneResult r;
-    r.scene = scene;
-    r.name = fs::path(scene).stem().string();
-    const fs::path work = root / dir;
-    r.dir = dir;
-    r.source = readSource(scene);
-    std::error_code ec;
-    fs::create_directories(work, ec);
-    const int W = o.width * o.ss, H = o.height * o.ss;
-    const std::vector<std::string> threads =
-        o.threads > 0 ? std::vector<std::string>{"--threads", std::to_string(o.threads)}
-                      : std::vector<std::string>{};
-
-    // 1. The native render of the cyclic graph.
-    const fs::path nativeFull = work / "native_full.png";
-    const RenderRun native = renderNative(scene, nativeFull.string(), W, H, threads);
-    if (!native.ok) {
-        r.message = native.error;
-        return r;
-    }
-    r.native.seconds = native.child.seconds;
-    // The render process's own peak (wait4 would report the larger of it and that of the
-    // pcsg-image it ran to write the image); the writer's is kept beside it.
-    r.native.peakRssBytes =
-        jsonField<uint64_t>(native.json, "peak_rss_bytes").value_or(native.child.peakRssBytes);
-    r.native.imageWriterPeakRssBytes =
-        jsonField<uint64_t>(native.json, "image_writer_peak_rss_bytes");
-    r.raysPerSecond = jsonField<double>(native.json, "rays_per_second");
-    r.graphBytes = jsonField<uint64_t>(native.json, "graph_bytes");
-    r.graphNodes = jsonField<uint64_t>(native.json, "graph_nodes");
-    r.native.parseSeconds = jsonField<double>(native.json, "parse_seconds");
-    r.native.traceSeconds = jsonField<double>(native.json, "seconds");
-    r.native.imageWriteSeconds = jsonField<double>(native.json, "image_write_seconds");
-
-    // 2. The expanded tree: its size, and the POV-Ray text.
-    const RenderRun stats = expandedStats(scene);
-    r.expandedBytes = jsonField<uint64_t>(stats.json, "expanded_bytes");
-    r.expandedNodes = jsonField<uint64_t>(stats.json, "expanded_nodes");
-    r.primitives = jsonField<uint64_t>(stats.json, "primitive_equivalence");
-    if (!r.graphBytes) r.graphBytes = jsonField<uint64_t>(stats.json, "graph_bytes");
-    if (!r.graphNodes) r.graphNodes = jsonField<uint64_t>(stats.json, "graph_nodes");
-    fs::path pov = work / (dir + ".pov");
-    if (!o.povFile.empty()) {
-        pov = o.povFile;
-        r.povFile = o.povFile;
-    } else {
-        const RenderRun exported = exportPov(scene, pov.string(), W, H);
-        if (!exported.ok) {
-            r.message = exported.error;
-            return r;
-        }
-        r.povFile = pov.filename().string();
-        r.povInReport = true;
-    }
-
-    // 3. POV-Ray on the exported text, without anti-aliasing, at the same size.
-    const fs::path povFull = work / "povray_full.png";
-    std::vector<std::string> povArgs = {"-A"};
-    if (o.threads > 0) povArgs.push_back("+WT" + std::to_string(o.threads));
-    const RenderRun povray = renderPovray(pov.string(), povFull.string(), W, H, povArgs);
-    if (!povray.child.started) {
-        r.message = povray.error;
-        return r;
-    }
-    if (!povray.ok) {
-        r.status = 1;  // POV-Ray rejecting our exported text is a failure of the exporter
-        r.message = povray.error;
-        return r;
-    }
-    r.povray.seconds = povray.child.seconds;
-    r.povray.peakRssBytes = povray.child.peakRssBytes;
-    r.povray.parseSeconds = povray.parseSeconds;
-    r.povray.traceSeconds = povray.traceSeconds;
-
-    // 4. The same box filter on both, then the comparison (pcsg-image compare), which also
-    // writes the reduced images and the heat map for the report.
-    ImageCompareOptions co;
-    co.ss = o.ss;
-    co.thresholds = o.thresholds;
-    co.reducedA = (work / "native.png").string();
-    co.reducedB = (work / "povray.png").string();
-    co.heatMap = (work / "diff.png").string();
-    const ImageCompareRun cmp =
-        compareImagesWithHelper(o.imageHelper, nativeFull.string(), povFull.string(), co);
-    if (cmp.widthA > 0 && cmp.widthB > 0 &&
-        (cmp.widthA != W || cmp.heightA != H || cmp.widthB != W || cmp.heightB != H)) {
-        r.message = fmt::format("image sizes differ: native {}x{}, POV-Ray {}x{}, expected {}x{}",
-                                cmp.widthA, cmp.heightA, cmp.widthB, cmp.heightB, W, H);
-        return r;
-    }
-    if (cmp.status == 2) {
-        r.message = "comparing the images failed:\n" + firstLines(cmp.error);
-        return r;
-    }
-    r.metrics = *cmp.metrics;
-    fs::remove(nativeFull, ec);
-    fs::remove(povFull, ec);
-    r.status = r.metrics.agree ? 0 : 1;
-    r.message = r.metrics.agree ? "the images agree" : "the images differ";
-    return r;
-}
-
-std::string opt(const std::optional<uint64_t>& v, bool bytes = true) {
-    if (!v) return "-";
-    return bytes ? humanBytes(*v) : fmt::format("{}", *v);
-}
-
-std::string ratio(const std::optional<uint64_t>& big, const std::optional<uint64_t>& small) {
-    if (!big || !small || *small == 0) return "-";
-    return fmt::format("{:.1f}x", double(*big) / double(*small));
-}
-
-void printResult(const SceneResult& r, std::ostream& out) {
-    const char* verdict = r.status == 0 ? "AGREE" : (r.status == 1 ? "DIFFER" : "ERROR");
-    out << fmt::format("{}: {} ({})\n", r.scene, verdict, r.message);
-    if (r.metrics.width > 0) {
-        const auto& m = r.metrics;
-        out << fmt::format(
-            "  image {}x{}: mean abs error {:.4f}, RMSE {:.4f}, PSNR {:.1f} dB, "
-            "pixels off {:.2f}%, largest difference {:.3f} at ({}, {})\n",
-            m.width, m.height, m.meanAbsError, m.rmse, m.psnr, 100 * m.shareOff, m.maxError, m.maxX,
-            m.maxY);
-        out << fmt::format(
-            "  memory: graph {} vs expanded tree {} ({}), native peak RSS {} vs "
-            "POV-Ray {} ({})\n",
-            opt(r.graphBytes), opt(r.expandedBytes), ratio(r.expandedBytes, r.graphBytes),
-            humanBytes(r.native.peakRssBytes), humanBytes(r.povray.peakRssBytes),
-            ratio(r.povray.peakRssBytes, r.native.peakRssBytes));
-        out << fmt::format(
-            "  time: native {:.2f} s, POV-Ray {:.2f} s{}; primitives {}\n", r.native.seconds,
-            r.povray.seconds,
-            r.povray.parseSeconds ? fmt::format(" ({:.2f} s parsing)", *r.povray.parseSeconds) : "",
-            opt(r.primitives, false));
-    }
-}
-
-nlohmann::json toJson(const SceneResult& r) {
-    nlohmann::json j;
-    j["scene"] = r.scene;
-    j["status"] = r.status == 0 ? "agree" : (r.status == 1 ? "differ" : "error");
-    j["message"] = r.message;
-    if (r.metrics.width > 0) {
-        const auto& m = r.metrics;
-        j["width"] = m.width;
-        j["height"] = m.height;
-        j["mean_abs_error"] = m.meanAbsError;
-        j["rmse"] = m.rmse;
-        j["psnr"] = std::isfinite(m.psnr) ? nlohmann::json(m.psnr) : nlohmann::json("inf");
-        j["max_error"] = m.maxError;
-        j["share_off"] = m.shareOff;
-        j["native_seconds"] = r.native.seconds;
-        j["native_peak_rss_bytes"] = r.native.peakRssBytes;
-        if (r.native.imageWriterPeakRssBytes)
-            j["native_image_writer_peak_rss_bytes"] = *r.native.imageWriterPeakRssBytes;
-        j["povray_seconds"] = r.povray.seconds;
-        j["povray_peak_rss_bytes"] = r.povray.peakRssBytes;
-        if (r.povray.parseSeconds) j["povray_parse_seconds"] = *r.povray.parseSeconds;
-    }
-    if (r.graphBytes) j["graph_bytes"] = *r.graphBytes;
-    if (r.expandedBytes) j["expanded_bytes"] = *r.expandedBytes;
-    if (r.expandedNodes) j["expanded_nodes"] = *r.expandedNodes;
-    if (r.primitives) j["primitive_equivalence"] = *r.primitives;
-    return j;
-}
-
-// ---- The HTML report --------------------------------------------------------------------
-//
-// Static pages, with no scripts but the images' inline load handlers and nothing from
-// elsewhere, linked by relative paths only, so the report directory can be moved or
-// copied as a whole:
-//
-//   DIR/index.html                  every scene: its verdict, thumbnails and main figures
-//   DIR/NAME/index.html             one scene: the three images, the metrics, memory, time
-//   DIR/NAME/native.png, povray.png, diff.png, NAME.pov
-//
-// Every <img> marks itself from inline onload/onerror handlers: data-state="loaded" and
-// data-natural="WxH", or data-state="broken", which also draws a red frame around it.
-// tests/report_in_chromium.sh reads these marks from headless Chromium's DOM.
 
 std::string htmlEscape(const std::string& s) {
     std::string out;
@@ -300,22 +55,6 @@ std::string summary(const std::string& message) {
         if (start != std::string::npos) return first + " " + line.substr(start);
     }
     return first.substr(0, first.size() - 1);
-}
-
-// A directory name for a scene inside the report: its file's stem, with anything but
-// letters, digits, '.', '-' and '_' replaced, so that links need no escaping; a name
-// already taken (two scenes/x.pcsg from different directories) gets "_2", "_3", ...
-std::string reportDirName(const std::string& scene, std::set<std::string>& taken) {
-    std::string base;
-    for (char c : fs::path(scene).stem().string())
-        base += std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_'
-                    ? c
-                    : '_';
-    if (base.empty() || base[0] == '.') base = "scene" + base;
-    std::string name = base;
-    for (int i = 2; taken.count(name); ++i) name = fmt::format("{}_{}", base, i);
-    taken.insert(name);
-    return name;
 }
 
 const char* kStyle = R"(<style>
@@ -400,17 +139,8 @@ std::string humanCount(double v) {
     return fmt::format("{:.0f}", v);
 }
 
-std::string localTime() {
-    const std::time_t now = std::time(nullptr);
-    char buf[64];
-    std::tm tm{};
-    localtime_r(&now, &tm);
-    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M %Z", &tm);
-    return buf;
-}
-
 // What every page says about how the images were made and judged.
-std::string settingsHtml(const VerifyOptions& o) {
+std::string settingsHtml(const VerifySettings& o) {
     const auto& t = o.thresholds;
     std::string h = "<p class=settings>";
     h += fmt::format("Both renderers drew {}&times;{} pixels without anti-aliasing{}",
@@ -495,14 +225,9 @@ std::string costTable(const SceneResult& r) {
             "for both)</td><td></td></tr>",
             *r.primitives);
     h += fmt::format(
-        "<tr><td>peak RSS of the render process</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+        "<tr><td>peak RSS of the render command</td><td>{}</td><td>{}</td><td>{}</td></tr>",
         bytes(r.native.peakRssBytes), bytes(r.povray.peakRssBytes),
         times(double(r.povray.peakRssBytes), double(r.native.peakRssBytes)));
-    if (r.native.imageWriterPeakRssBytes)
-        h += fmt::format(
-            "<tr><td class=sub>peak RSS of <code>pcsg-image write</code>, a process of its "
-            "own</td><td>{}</td><td>-</td><td></td></tr>",
-            bytes(*r.native.imageWriterPeakRssBytes));
     h += fmt::format(
         "<tr><td>wall time of the render process</td><td>{}</td><td>{}</td><td>{}</td></tr>",
         seconds(r.native.seconds), seconds(r.povray.seconds),
@@ -513,14 +238,15 @@ std::string costTable(const SceneResult& r) {
                      seconds(r.native.traceSeconds), seconds(r.povray.traceSeconds));
     if (r.native.imageWriteSeconds)
         h += fmt::format(
-            "<tr><td class=sub>writing the image (<code>pcsg-image</code>, start-up "
-            "included)</td><td>{}</td><td>-</td><td></td></tr>",
+            "<tr><td class=sub>writing the PNG (libpng, in the render "
+            "process)</td><td>{}</td><td>-</td><td></td></tr>",
             seconds(r.native.imageWriteSeconds));
     if (r.raysPerSecond)
         h += fmt::format("<tr><td>rays per second</td><td>{}</td><td>-</td><td></td></tr>",
                          humanCount(*r.raysPerSecond));
-    h += "</table><p class=note>Peak RSS is the largest resident set of each process, as the "
-         "kernel counted it. Wall time is the whole process's, start-up and writing the image "
+    h += "</table><p class=note>Peak RSS is the largest resident set of each render command, "
+         "as the kernel counted it (and /usr/bin/time -v prints it). Wall time is the whole "
+         "process's, start-up and writing the image "
          "included; the indented parts are what each program measured of itself.</p>";
     return h;
 }
@@ -531,7 +257,34 @@ int pageScale(int width) {
     return std::clamp(400 / std::max(width, 1), 1, 8);
 }
 
-void writeScenePage(const SceneResult& r, const VerifyOptions& o, const std::string& written,
+}  // namespace
+
+// A directory name for a scene inside the report: its file's stem, with anything but
+// letters, digits, '.', '-' and '_' replaced, so that links need no escaping; a name
+// already taken (two scenes/x.pcsg from different directories) gets "_2", "_3", ...
+std::string reportDirName(const std::string& scene, std::set<std::string>& taken) {
+    std::string base;
+    for (char c : fs::path(scene).stem().string())
+        base += std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_'
+                    ? c
+                    : '_';
+    if (base.empty() || base[0] == '.') base = "scene" + base;
+    std::string name = base;
+    for (int i = 2; taken.count(name); ++i) name = fmt::format("{}_{}", base, i);
+    taken.insert(name);
+    return name;
+}
+
+std::string localTime() {
+    const std::time_t now = std::time(nullptr);
+    char buf[64];
+    std::tm tm{};
+    localtime_r(&now, &tm);
+    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M %Z", &tm);
+    return buf;
+}
+
+void writeScenePage(const SceneResult& r, const VerifySettings& o, const std::string& written,
                     const fs::path& root) {
     std::ofstream out(root / r.dir / "index.html");
     out << "<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>" << htmlEscape(r.name)
@@ -596,7 +349,7 @@ void writeScenePage(const SceneResult& r, const VerifyOptions& o, const std::str
 
 // The index of all scenes, rewritten after each one so that a long run can be watched;
 // `pending` scenes are still to come.
-void writeIndex(const std::vector<SceneResult>& results, size_t pending, const VerifyOptions& o,
+void writeIndex(const std::vector<SceneResult>& results, size_t pending, const VerifySettings& o,
                 const std::string& written, const fs::path& root) {
     constexpr int kThumb = 96;  // thumbnail width in CSS pixels
     size_t agree = 0;
@@ -647,130 +400,10 @@ void writeIndex(const std::vector<SceneResult>& results, size_t pending, const V
             << "</td></tr>";
     }
     out << "</table></div><p class=note>Mean absolute error and pixels off as defined above; peak "
-           "RSS is each render process's largest resident set; wall time is each render "
+           "RSS is each render command's largest resident set; wall time is each render "
            "process's, start-up included. A scene's page has the details.</p>";
     out << "<footer>Written by <code>pcsg verify</code> on " << htmlEscape(written)
         << ".</footer></body></html>\n";
-}
-
-int runVerify(VerifyOptions o) {
-    if (!o.allDir.empty()) {
-        std::error_code ec;
-        std::vector<std::string> found;
-        for (const auto& e : fs::directory_iterator(o.allDir, ec))
-            if (e.path().extension() == ".pcsg") found.push_back(e.path().string());
-        if (ec) {
-            std::cerr << "pcsg verify: cannot read directory " << o.allDir << ": " << ec.message()
-                      << "\n";
-            return 2;
-        }
-        std::sort(found.begin(), found.end());
-        o.scenes.insert(o.scenes.end(), found.begin(), found.end());
-    }
-    if (o.scenes.empty()) {
-        std::cerr << "pcsg verify: no scene given (a .pcsg file, or --all DIR)\n";
-        return 2;
-    }
-    if (o.ss < 1 || o.width < 1 || o.height < 1) {
-        std::cerr << "pcsg verify: --width, --height and --ss must be positive\n";
-        return 2;
-    }
-    if (!inPath("povray")) {
-        std::cerr << "pcsg verify: POV-Ray is not installed (it renders the exported tree): "
-                     "install it with `apt-get install povray`\n";
-        return 2;
-    }
-    if (const auto helper = findImageHelper()) {
-        o.imageHelper = *helper;
-    } else {
-        std::cerr << "pcsg verify: " << missingImageHelperMessage() << "\n";
-        return 2;
-    }
-    fs::path root;
-    bool temporary = false;
-    if (!o.reportDir.empty()) {
-        root = o.reportDir;
-    } else {
-        char tmpl[] = "/tmp/pcsg-verify-XXXXXX";
-        if (!mkdtemp(tmpl)) {
-            std::cerr << "pcsg verify: cannot create a temporary directory\n";
-            return 2;
-        }
-        root = tmpl;
-        temporary = !o.keep;
-    }
-    std::error_code ec;
-    fs::create_directories(root, ec);
-
-    std::vector<SceneResult> results;
-    int status = 0;
-    const std::string written = localTime();
-    std::set<std::string> dirs = {"index.html"};  // the report's own page is taken
-    for (const auto& scene : o.scenes) {
-        if (!o.json && o.scenes.size() > 1) std::cerr << "verifying " << scene << " ...\n";
-        SceneResult r = verifyScene(scene, reportDirName(scene, dirs), o, root);
-        if (!o.json) printResult(r, std::cout);
-        status = std::max(status, r.status);
-        results.push_back(std::move(r));
-        if (!o.reportDir.empty()) {
-            writeScenePage(results.back(), o, written, root);
-            writeIndex(results, o.scenes.size() - results.size(), o, written, root);
-        }
-    }
-    if (o.json) {
-        nlohmann::json j = nlohmann::json::array();
-        for (const auto& r : results) j.push_back(toJson(r));
-        std::cout << (results.size() == 1 ? j[0] : j).dump(2) << "\n";
-    } else {
-        size_t agree = 0;
-        for (const auto& r : results) agree += r.status == 0;
-        std::cout << fmt::format("{} of {} scene(s) agree", agree, results.size());
-        if (!o.reportDir.empty())
-            std::cout << "; report: " << (root / "index.html").string();
-        else if (o.keep)
-            std::cout << "; images kept in " << root.string();
-        std::cout << "\n";
-    }
-    if (temporary) fs::remove_all(root, ec);
-    return status;
-}
-
-}  // namespace
-
-void addVerifyCommand(CLI::App& app, int& status) {
-    auto o = std::make_shared<VerifyOptions>();
-    auto* cmd = app.add_subcommand(
-        "verify",
-        "Render a scene natively (the cyclic graph) and with POV-Ray (the expanded tree written "
-        "by\n"
-        "export-pov), both without anti-aliasing at --ss times the size, reduce both with the "
-        "same\n"
-        "box filter, and compare them. Exit status: 0 the images agree, 1 they differ, 2 "
-        "something\n"
-        "could not run. Also reports memory (graph vs expanded tree, both peak RSS) and time.\n"
-        "The images are compared by the pcsg-image helper (beside pcsg, or in PATH).");
-    cmd->add_option("scenes", o->scenes, "Scene files (.pcsg)");
-    cmd->add_option("--all", o->allDir, "Verify every .pcsg file in this directory");
-    cmd->add_option("--width", o->width, "Image width after reduction")->capture_default_str();
-    cmd->add_option("--height", o->height, "Image height after reduction")->capture_default_str();
-    cmd->add_option("--ss", o->ss, "Supersampling factor K: both render K*W x K*H")
-        ->capture_default_str();
-    cmd->add_option("--threads", o->threads, "Threads for both renderers (default: all cores)");
-    cmd->add_option("--report", o->reportDir,
-                    "Write an HTML report into this directory; open DIR/index.html");
-    cmd->add_option("--pov", o->povFile, "Render this POV-Ray file instead of exporting the scene");
-    cmd->add_option("--pixel-threshold", o->thresholds.pixelOff,
-                    "A pixel is off when a channel differs by more than this (0..1)")
-        ->capture_default_str();
-    cmd->add_option("--max-off", o->thresholds.maxShareOff,
-                    "Agree only if at most this share of pixels is off")
-        ->capture_default_str();
-    cmd->add_option("--max-mean-error", o->thresholds.maxMeanError,
-                    "Agree only if the mean absolute error is at most this")
-        ->capture_default_str();
-    cmd->add_flag("--json", o->json, "Print the results as JSON");
-    cmd->add_flag("--keep", o->keep, "Keep the images (in a temporary directory) without --report");
-    cmd->callback([o, &status] { status = runVerify(*o); });
 }
 
 }  // namespace pcsg::tools

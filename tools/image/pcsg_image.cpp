@@ -6,8 +6,10 @@
 //
 // OpenImageIO pulls in ~260 shared libraries, which cost a process ~130 MB of peak RSS and
 // half a second of start-up; `pcsg` does not link it, so that renders and tests stay
-// small, and runs this helper instead (tools/image_helper.h): `pcsg render` pipes its
-// pixels to `write`, `pcsg verify` runs `compare`. See `pcsg-image --help`.
+// small, and runs this helper, to its end, only where OpenImageIO is needed
+// (tools/image/image_helper.h): `pcsg render` pipes an EXR's or TIFF's pixels to `write`
+// (a PNG it writes itself, through the same libpng writer `write` uses for .png), and
+// `pcsg verify` runs `compare`. See `pcsg-image --help`.
 //
 // Exit status: write: 0 written, 2 not (nothing is left behind); compare: 0 the images
 // agree, 1 they differ, 2 the comparison could not run.
@@ -153,9 +155,9 @@ int main(int argc, char** argv) {
     CLI::App app{
         "pcsg-image: the image files of pcsg, through OpenImageIO, in a process of their own.\n"
         "pcsg does not link OpenImageIO (its shared libraries cost every process ~130 MB of\n"
-        "memory), so that the renderer stays small: `pcsg render` pipes its pixels to\n"
-        "`pcsg-image write`, and `pcsg verify` runs `pcsg-image compare`. It is found beside\n"
-        "the pcsg executable, or in PATH.",
+        "memory), so that the renderer stays small: `pcsg render` writes a PNG itself, pipes\n"
+        "an EXR's or TIFF's pixels to `pcsg-image write`, and `pcsg verify` runs\n"
+        "`pcsg-image compare`. It is found beside the pcsg executable, or in PATH.",
         "pcsg-image"};
     app.require_subcommand(1);
     int status = 0;

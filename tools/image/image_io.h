@@ -1,6 +1,7 @@
-// Writing rendered pixels to an image file through OpenImageIO. Part of the pcsg_image
-// library, which only the pcsg-image helper and the image tests link: the renderer hands
-// its pixels to `pcsg-image write` through a pipe, so that no rendering process pays for
+// Writing rendered pixels to an image file: EXR and TIFF through OpenImageIO, PNG through
+// libpng (tools/image/png_writer.h). Part of the pcsg_image library, which only the
+// pcsg-image helper and the image tests link: `pcsg render` writes a PNG itself and pipes
+// an EXR's or TIFF's pixels to `pcsg-image write`, so that a PNG render never pays for
 // OpenImageIO's ~260 shared libraries (~130 MB of peak RSS, half a second of start-up).
 #pragma once
 

@@ -1,0 +1,196 @@
+// pcsg export-pov SCENE -o OUT.pov [--max-nodes N] [--width W --height H] [--json]:
+// unroll the cyclic graph into a finite CSG tree (povexport/expander.h) and write it as
+// POV-Ray 3.7 scene text (povexport/pov_writer.h).
+//
+// Exit status: 0 success, 1 the scene is at fault (compile error, run-time error, too
+// large for the node budget), 2 something could not run (the output is not writable).
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include "commands.h"
+#include "eval.h"
+#include "expander.h"
+#include "pov_writer.h"
+#include "scene_input.h"
+#include "stats.h"
+
+namespace pcsg::tools {
+
+namespace {
+
+double since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+struct ExportOptions {
+    std::string scene;
+    std::string output;
+    uint64_t maxNodes = 10'000'000;
+    int width = 640, height = 480;
+    uint32_t maxUnion = 32;
+    bool json = false;
+};
+
+// Unrolls the graph; nullopt (with the error printed) when the scene is at fault.
+std::optional<ExpandedTree> expandScene(const Graph& g, const ExportOptions& o) {
+    try {
+        ExpandOptions eo;
+        eo.maxNodes = o.maxNodes;
+        return expand(g, eo);
+    } catch (const RuntimeError& e) {
+        std::cerr << e.format(g) << "\n";
+    } catch (const BudgetError& e) {
+        std::cerr << fmt::format("pcsg export-pov: error: {}: {}\n", o.scene, e.what());
+    } catch (const std::bad_alloc&) {
+        std::cerr << fmt::format(
+            "pcsg export-pov: error: {}: out of memory while expanding; lower --max-nodes\n",
+            o.scene);
+    }
+    return std::nullopt;
+}
+
+// Streams the POV-Ray text to the file, written beside the target and renamed at the
+// end: a failed export leaves no partial file in place of the requested one. Throws
+// std::runtime_error with the message to print.
+PovWriteStats writePovFile(const Graph& g, const ExpandedTree& tree, const PovOptions& po,
+                           const std::string& output) {
+    namespace fs = std::filesystem;
+    const fs::path target(output);
+    const fs::path temp = target.string() + ".partial";
+    PovWriteStats written;
+    {
+        std::vector<char> buffer(1 << 20);  // declared first: it outlives the stream
+        std::ofstream out;
+        out.rdbuf()->pubsetbuf(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+        out.open(temp, std::ios::binary | std::ios::trunc);
+        if (!out)
+            throw std::runtime_error(
+                fmt::format("cannot write {}: {}", output, std::strerror(errno)));
+        try {
+            written = writePov(g, tree, out, po);
+            out.close();
+            if (!out) throw std::runtime_error("could not write the POV-Ray file");
+        } catch (const std::exception& e) {
+            std::error_code ec;
+            fs::remove(temp, ec);
+            throw std::runtime_error(fmt::format("{} {}", e.what(), output));
+        }
+    }
+    std::error_code ec;
+    fs::rename(temp, target, ec);
+    if (ec) {
+        const std::string why = ec.message();
+        fs::remove(temp, ec);
+        throw std::runtime_error(fmt::format("cannot write {}: {}", output, why));
+    }
+    return written;
+}
+
+void printExport(const ExportOptions& o, const Stats& s, const PovWriteStats& written,
+                 double expandSeconds, double writeSeconds) {
+    // With -o -, standard output is the scene: the report goes to standard error.
+    std::ostream& report = o.output == "-" ? std::cerr : std::cout;
+    if (o.json) {
+        nlohmann::json j = s.toJson();
+        j["output"] = o.output;
+        j["pov_bytes"] = written.bytes;
+        j["pov_objects"] = written.objects;
+        j["skipped_degenerate_triangles"] = written.skipped;
+        j["expand_seconds"] = expandSeconds;
+        j["write_seconds"] = writeSeconds;
+        report << j.dump(2) << "\n";
+        return;
+    }
+    report << fmt::format("{}: wrote {} ({} objects, {}) in {:.3f} s\n", o.scene,
+                          o.output == "-" ? std::string("standard output") : o.output,
+                          written.objects, humanBytes(written.bytes), *s.seconds);
+    if (written.skipped)
+        report << fmt::format(
+            "  left out {} degenerate triangle{} (no area; POV-Ray rejects them)\n",
+            written.skipped, written.skipped == 1 ? "" : "s");
+}
+
+int runExport(const ExportOptions& o) {
+    const CompiledScene compiled = compileScene(o.scene, std::cerr);
+    if (!compiled.graph) return 1;
+    const Graph& g = *compiled.graph;
+
+    const auto start = std::chrono::steady_clock::now();
+    const std::optional<ExpandedTree> tree = expandScene(g, o);
+    if (!tree) return 1;
+    const double expandSeconds = since(start);
+
+    PovOptions po;
+    po.width = o.width;
+    po.height = o.height;
+    po.maxUnionChildren = o.maxUnion;
+    po.title = o.scene;
+    PovWriteStats written;
+    const auto writeStart = std::chrono::steady_clock::now();
+    try {
+        written = o.output == "-" ? writePov(g, *tree, std::cout, po)
+                                  : writePovFile(g, *tree, po, o.output);
+    } catch (const std::exception& e) {
+        std::cerr << "pcsg export-pov: " << e.what()
+                  << (o.output == "-" ? " (standard output)\n" : "\n");
+        return 2;
+    }
+    const double writeSeconds = since(writeStart);
+
+    Stats s;
+    s.scene = o.scene;
+    s.width = static_cast<uint32_t>(o.width);
+    s.height = static_cast<uint32_t>(o.height);
+    s.primitiveEquivalence = tree->primitives.size();
+    s.expandedNodes = tree->nodes.size();
+    s.graphBytes = g.graphBytes();
+    s.expandedBytes = tree->bytes();
+    s.parseSeconds = compiled.seconds;
+    s.seconds = expandSeconds + writeSeconds;
+    s.peakRssBytes = peakRssBytes();
+    printExport(o, s, written, expandSeconds, writeSeconds);
+    return 0;
+}
+
+}  // namespace
+
+void addExportCommand(CLI::App& app, int& status) {
+    auto e = std::make_shared<ExportOptions>();
+    auto* ex = app.add_subcommand(
+        "export-pov",
+        "Unroll the scene's cyclic graph into a finite CSG tree and write it as POV-Ray 3.7 "
+        "scene text (render it with `povray +IOUT.pov +W640 +H480`)");
+    ex->add_option("scene", e->scene, "The .pcsg file (- reads standard input)")->required();
+    ex->add_option("-o,--output", e->output, "The POV-Ray file to write (- for standard output)")
+        ->required();
+    ex->add_option("--max-nodes", e->maxNodes,
+                   "Node budget of the expanded tree: a larger expansion stops with an error "
+                   "that says how many nodes it would need")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    ex->add_option("--width", e->width, "Image width the camera's aspect ratio is set for")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    ex->add_option("--height", e->height, "Image height the camera's aspect ratio is set for")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    ex->add_option("--max-union", e->maxUnion,
+                   "Unions with more operands are regrouped into a balanced nest of at most "
+                   "this many per level")
+        ->capture_default_str()
+        ->check(CLI::Range(2u, 100000u));
+    ex->add_flag("--json", e->json, "Print the export's figures as JSON");
+    ex->callback([e, &status] { status = runExport(*e); });
+}
+
+}  // namespace pcsg::tools

@@ -1,0 +1,321 @@
+// pcsg render SCENE -o OUT [--width W] [--height H] [--aa N] [--adaptive T] [--threads N]
+//                          [--json]
+// Ray traces the scene's cyclic graph directly (tracer/): the graph is never expanded.
+// Prints the figures of the paper's Table 1 and more (tools/cli/stats.h).
+//
+// A PNG is written in this process through libpng (tools/image/png_writer.h), so that the
+// whole command stays small: OpenImageIO's ~260 shared libraries would cost it ~130 MB.
+// An EXR or TIFF file is written by the pcsg-image helper (tools/image/image_helper.h),
+// run once the pixels exist, which gets them through a pipe. The peak RSS printed is the
+// whole command's (this process's, or the helper's when that is larger), what
+// /usr/bin/time -v reports; the helper's own is printed beside it.
+//
+// Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
+// run-time error of docs/language.md, reported once with its module path; no image is
+// written); 2 something could not run (bad options, an unwritable output file, no
+// pcsg-image for an EXR or TIFF file).
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <mutex>
+
+#include "commands.h"
+#include "eval.h"
+#include "expander.h"
+#include "image_format.h"
+#include "image_helper.h"
+#include "png_writer.h"
+#include "render.h"
+#include "scene_input.h"
+#include "stats.h"
+#include "traversal.h"
+
+namespace pcsg::tools {
+
+namespace {
+
+struct RenderCommandOptions {
+    std::string scene;
+    std::string output;
+    int width = 640, height = 480;
+    int aa = 1;
+    double adaptive = 0;
+    int threads = 0;
+    bool json = false;
+    bool noBounds = false;
+    bool noInstanceBoxes = false;
+    size_t boxCacheMb = 64;
+    size_t expansionCacheMb = 16;
+    uint64_t countVisits = 20'000'000;
+};
+
+// A progress bar on standard error, redrawn at most every 1%.
+class ProgressBar {
+  public:
+    void update(double fraction) {
+        const int percent = static_cast<int>(fraction * 100);
+        if (percent <= shown_.load(std::memory_order_relaxed)) return;
+        std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+        if (!lock.owns_lock() || percent <= shown_) return;
+        shown_ = percent;
+        const int width = 40, filled = percent * width / 100;
+        const double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        std::fprintf(stderr, "\r  [%s%s] %3d%%  %.1f s", std::string(filled, '#').c_str(),
+                     std::string(width - filled, '.').c_str(), percent, elapsed);
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (shown_ >= 0) std::fprintf(stderr, "\r%70s\r", "");
+    }
+
+  private:
+    std::mutex mutex_;
+    std::atomic<int> shown_{-1};
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+// What the render computed and wrote, printed as text or JSON by printRender().
+struct RenderReport {
+    Stats stats;
+    ExpansionCount count;
+    tracer::RenderResult result;  // its pixels released once written
+    size_t graphNodes = 0;
+    double imageWriteSeconds = 0;            // writing the image file
+    std::optional<ImageWriteResult> helper;  // pcsg-image, for EXR and TIFF
+};
+
+// Writes the pixels: a PNG here, an EXR or TIFF through pcsg-image. Returns the error
+// message, empty on success.
+std::string writeOutput(const RenderCommandOptions& o, const std::string& imageHelper,
+                        RenderReport& report) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::span<const float> rgb = report.result.rgb;
+    if (imageFormatOf(o.output) == ImageFormat::png) {
+        try {
+            writePng(o.output, o.width, o.height, rgb);
+        } catch (const std::runtime_error& e) {
+            return e.what();
+        }
+    } else {
+        report.helper = writeImageWithHelper(imageHelper, o.output, o.width, o.height, rgb);
+        if (!report.helper->ok) return report.helper->error;
+    }
+    report.imageWriteSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return {};
+}
+
+tracer::RenderOptions tracerOptions(const RenderCommandOptions& o) {
+    tracer::RenderOptions ro;
+    ro.width = o.width;
+    ro.height = o.height;
+    ro.aa = o.aa;
+    ro.adaptive = o.adaptive;
+    ro.threads = o.threads;
+    ro.useBounds = !o.noBounds;
+    ro.instanceBoxes = !o.noInstanceBoxes;
+    ro.instanceBoxBytes = o.boxCacheMb << 20;
+    ro.expansionBytesPerThread = o.expansionCacheMb << 20;
+    return ro;
+}
+
+// Counts the expansion and renders; returns the exit status (0, or 1 and 2 with the
+// error printed).
+int countAndRender(const Graph& g, const RenderCommandOptions& o, RenderReport& report) {
+    // Primitive equivalence: what the expanded tree would hold, counted without building
+    // it. The count walks every path of the expansion (memoised), so it also finds the
+    // scene's run-time errors on paths no ray visits.
+    tracer::RenderOptions ro = tracerOptions(o);
+    auto bar = std::make_shared<ProgressBar>();
+    const bool showProgress = isatty(STDERR_FILENO) != 0;
+    if (showProgress) ro.progress = [bar](double f) { bar->update(f); };
+    try {
+        CountOptions co;
+        co.maxVisits = o.countVisits;
+        report.count = countExpansion(g, co);
+        report.result = tracer::render(g, ro);
+    } catch (const RuntimeError& e) {
+        if (showProgress) bar->finish();
+        std::cerr << e.format(g) << "\n";
+        return 1;
+    } catch (const std::exception& e) {
+        if (showProgress) bar->finish();
+        std::cerr << "pcsg render: error: " << o.scene << ": " << e.what() << "\n";
+        return 2;
+    }
+    if (showProgress) bar->finish();
+    return 0;
+}
+
+void printJson(const RenderCommandOptions& o, const RenderReport& report) {
+    const tracer::RenderResult& result = report.result;
+    nlohmann::json j = report.stats.toJson();
+    j["output"] = o.output;
+    j["node_visits"] = result.nodeVisits;
+    j["bounds_seconds"] = result.boundsSeconds;
+    j["unbounded_nodes"] = result.infiniteBoxes;
+    j["instance_boxes"] = {{"entries", result.instanceBoxes.entries},
+                           {"bytes", result.instanceBoxes.bytes},
+                           {"computed", result.instanceBoxes.computed},
+                           {"full", result.instanceBoxes.full}};
+    j["expanded_instances"] = result.expansions;
+    j["aa"] = o.aa;
+    j["adaptive"] = o.adaptive;
+    j["graph_nodes"] = report.graphNodes;
+    // After the render: the part of the wall time spent on the image.
+    j["image_write_seconds"] = report.imageWriteSeconds;
+    if (report.helper) {
+        j["image_writer_peak_rss_bytes"] = report.helper->peakRssBytes;
+        j["image_writer_seconds"] = report.helper->seconds;  // its whole life
+    }
+    if (!report.count.complete)
+        j["primitive_equivalence_note"] = "too large to count (rand/choose)";
+    std::cout << j.dump(2) << "\n";
+}
+
+void printText(const RenderCommandOptions& o, const RenderReport& report) {
+    const tracer::RenderResult& result = report.result;
+    std::cout << fmt::format("{}: wrote {} ({}x{}) in {:.3f} s\n", o.scene, o.output, o.width,
+                             o.height, result.seconds);
+    report.stats.print(std::cout);
+    if (!report.count.complete)
+        std::cout << fmt::format("{:<24}{}\n", "primitive equivalence",
+                                 "too large to count (the system uses rand() or choose())");
+    std::cout << fmt::format("{:<24}{}\n", "graph nodes", report.graphNodes);
+    std::cout << fmt::format("{:<24}{}\n", "node visits", result.nodeVisits);
+    if (result.instanceBoxes.entries > 0)
+        std::cout << fmt::format(
+            "{:<24}{} instances, {}{}\n", "instance-box cache", result.instanceBoxes.entries,
+            humanBytes(result.instanceBoxes.bytes), result.instanceBoxes.full ? " (full)" : "");
+    if (report.helper)
+        std::cout << fmt::format("{:<24}{} ({}, {:.3f} s after the render)\n",
+                                 "image writer peak RSS", humanBytes(report.helper->peakRssBytes),
+                                 kImageHelperName, report.imageWriteSeconds);
+    else
+        std::cout << fmt::format("{:<24}{:.3f} s (libpng, in this process)\n", "image write time",
+                                 report.imageWriteSeconds);
+}
+
+int runRender(const RenderCommandOptions& o) {
+    // Before the render: without a writer, the render would be for nothing.
+    std::string imageHelper;
+    if (imageFormatOf(o.output) != ImageFormat::png) {
+        const std::optional<std::string> found = findImageHelper();
+        if (!found) {
+            std::cerr << "pcsg render: cannot write '" << o.output
+                      << "': " << missingImageHelperMessage() << "\n";
+            return 2;
+        }
+        imageHelper = *found;
+    }
+    const CompiledScene compiled = compileScene(o.scene, std::cerr);
+    if (!compiled.graph) return 1;
+    const Graph& g = *compiled.graph;
+
+    RenderReport report;
+    if (const int status = countAndRender(g, o, report)) return status;
+    if (const std::string error = writeOutput(o, imageHelper, report); !error.empty()) {
+        std::cerr << "pcsg render: " << error << "\n";
+        return 2;
+    }
+    report.result.rgb = {};  // written: the printing needs only the figures
+    report.graphNodes = g.nodes.size();
+    Stats& s = report.stats;
+    s.scene = o.scene;
+    s.width = static_cast<uint32_t>(o.width);
+    s.height = static_cast<uint32_t>(o.height);
+    s.graphBytes = g.graphBytes();
+    s.parseSeconds = compiled.seconds;
+    if (report.count.complete) s.primitiveEquivalence = report.count.primitives;
+    s.rays = report.result.rays;
+    s.seconds = report.result.seconds;
+    s.raysPerSecond = s.seconds > 0 ? report.result.rays / *s.seconds : 0.0;
+    s.peakRssBytes = wholeCommandPeakRssBytes();  // the helper's included
+    if (o.json)
+        printJson(o, report);
+    else
+        printText(o, report);
+    return 0;
+}
+
+// CLI11 validator: the output's extension names an image type pcsg writes.
+const CLI::Validator kImageOutput(
+    [](const std::string& path) -> std::string {
+        if (imageFormatOf(path)) return {};
+        return fmt::format("cannot write '{}': unknown image type ({})", path, kImageTypesHint);
+    },
+    "IMAGE");
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app, int& status) {
+    auto o = std::make_shared<RenderCommandOptions>();
+    auto* cmd = app.add_subcommand(
+        "render",
+        "Ray trace a scene's cyclic CSG graph directly, without expanding it, and write the "
+        "image (.png 8-bit sRGB, .exr linear float, .tif 16-bit sRGB). Camera, lights and "
+        "materials follow POV-Ray 3.7, so the image can be compared with POV-Ray's rendering "
+        "of `pcsg export-pov`. Prints rays, rays per second, primitive equivalence (the "
+        "primitives the expanded tree would hold), graph bytes, peak memory and time. A PNG is "
+        "written in this process; an EXR or TIFF file by the pcsg-image helper (found beside "
+        "pcsg, or in PATH), which gets the pixels through a pipe once they exist.\n"
+        "Exit status: 0 written, 1 the scene has an error (nothing written), 2 could not run.");
+    cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input)")->required();
+    cmd->add_option("-o,--output", o->output, "The image to write: .png, .exr, .tif or .tiff")
+        ->required()
+        ->check(kImageOutput);
+    cmd->add_option("--width", o->width, "Image width in pixels")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--height", o->height, "Image height in pixels")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    auto* aa = cmd->add_option("--aa", o->aa,
+                               "Anti-aliasing: N x N stratified samples per pixel (1: none)")
+                   ->capture_default_str()
+                   ->check(CLI::Range(1, 64));
+    cmd->add_option("--adaptive", o->adaptive,
+                    "Adaptive anti-aliasing like POV-Ray's +A T (e.g. 0.3): pixels that differ "
+                    "from a neighbour by T or more get 9 more samples (0: off)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 3.0))
+        ->excludes(aa);
+    cmd->add_option("--threads", o->threads,
+                    "Worker threads (0: all cores); the image is the "
+                    "same whatever the count")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--json", o->json, "Print the figures as JSON");
+    cmd->add_flag("--no-bounds", o->noBounds,
+                  "Do not cull with hyper-bounding boxes (slow; for checking that culling never "
+                  "changes the image)");
+    cmd->add_flag("--no-instance-boxes", o->noInstanceBoxes,
+                  "Cull with the static hyper-bounding boxes alone, without the exact boxes of "
+                  "sub-graph instances (for comparison; the image is the same)");
+    cmd->add_option("--box-cache-mb", o->boxCacheMb,
+                    "Memory limit of the instance-box cache in MB (the exact boxes of sub-graph "
+                    "instances, filled lazily while rendering)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
+    cmd->add_option("--expansion-cache-mb", o->expansionCacheMb,
+                    "Memory limit per thread, in MB, of the cache of expanded sub-graph "
+                    "instances (small instances unrolled once and traced as flat arrays; 0: "
+                    "none; the image is the same)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
+    cmd->add_option("--count-visits", o->countVisits,
+                    "Work limit of the primitive-equivalence count in graph-node visits")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    cmd->callback([o, &status] { status = runRender(*o); });
+}
+
+}  // namespace pcsg::tools

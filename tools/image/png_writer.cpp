@@ -1,0 +1,109 @@
+#include "png_writer.h"
+
+#include <fmt/format.h>
+#include <png.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+#include "image_format.h"
+
+namespace pcsg::tools {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr size_t kMessageSize = 256;
+
+// libpng reports an error through its callback, which must not return: this one keeps the
+// message (in the error pointer's buffer) and jumps back to encode()'s setjmp.
+[[noreturn]] void onPngError(png_structp png, png_const_charp message) {
+    char* into = static_cast<char*>(png_get_error_ptr(png));
+    std::snprintf(into, kMessageSize, "%s", message);
+    png_longjmp(png, 1);
+}
+
+void onPngWarning(png_structp, png_const_charp) {}
+
+// Encodes the image into an open file; false with the message in `error` (kMessageSize
+// bytes) when libpng failed. No C++ object lives across the setjmp.
+bool encode(FILE* file, int width, int height, const uint8_t* bytes, char* error) {
+    png_structp png =
+        png_create_write_struct(PNG_LIBPNG_VER_STRING, error, onPngError, onPngWarning);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!info) {
+        png_destroy_write_struct(&png, nullptr);
+        std::snprintf(error, kMessageSize, "libpng could not start");
+        return false;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return false;
+    }
+    png_init_io(png, file);
+    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+                 PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_text software{};
+    software.compression = PNG_TEXT_COMPRESSION_NONE;
+    software.key = const_cast<png_charp>("Software");
+    software.text = const_cast<png_charp>("pcsg");
+    png_set_text(png, info, &software, 1);
+    png_write_info(png, info);
+    const size_t stride = static_cast<size_t>(width) * 3;
+    for (int y = 0; y < height; ++y) png_write_row(png, bytes + static_cast<size_t>(y) * stride);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
+}  // namespace
+
+std::vector<uint8_t> srgbBytes(std::span<const float> rgb) {
+    std::vector<uint8_t> bytes(rgb.size());
+    for (size_t i = 0; i < rgb.size(); ++i)
+        bytes[i] = static_cast<uint8_t>(std::lround(srgbEncode(rgb[i]) * 255.0));
+    return bytes;
+}
+
+void writePng(const std::string& path, int width, int height, std::span<const float> rgb) {
+    auto fail = [&](const std::string& why) {
+        throw std::runtime_error(fmt::format("cannot write '{}': {}", path, why));
+    };
+    if (width <= 0 || height <= 0)
+        fail(fmt::format("the image size {}x{} is not positive", width, height));
+    const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height) * 3;
+    if (rgb.size() != n)
+        fail(fmt::format("{} values for a {}x{} RGB image (expected {})", rgb.size(), width, height,
+                         n));
+    const std::vector<uint8_t> bytes = srgbBytes(rgb);
+
+    const fs::path target(path);
+    const fs::path tmp = temporaryBeside(target);
+    FILE* file = std::fopen(tmp.c_str(), "wb");
+    if (!file) fail(std::strerror(errno));
+    char message[kMessageSize] = "";
+    std::string error;
+    if (!encode(file, width, height, bytes.data(), message)) error = message;
+    // fclose flushes what stdio buffered: it can fail too (a full disk).
+    const bool flushed = std::ferror(file) == 0;
+    const bool closed = std::fclose(file) == 0;
+    if (error.empty() && (!flushed || !closed)) error = std::strerror(errno);
+    std::error_code ec;
+    if (error.empty()) fs::rename(tmp, target, ec);
+    if (ec) error = ec.message();
+    if (!error.empty()) {
+        fs::remove(tmp, ec);
+        fail(error);
+    }
+}
+
+}  // namespace pcsg::tools
