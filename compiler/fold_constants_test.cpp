@@ -120,7 +120,8 @@ struct FlatSink {
 Flat flatten(const Graph& g) {
     Flat f;
     FlatSink sink{f};
-    Walker<FlatSink> walker(g, sink);
+    const Semantics sem(g);
+    Walker<FlatSink> walker(sem, sink);
     walker.run();
     return f;
 }

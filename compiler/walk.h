@@ -1,5 +1,5 @@
 // The one walk that unrolls the cyclic graph: an explicit-stack traversal of every path
-// from a start node, following the one semantics of eval.h (selection, C-nodes, T-node
+// from a start node, each step the one step of semantics.h (selection, C-nodes, T-node
 // matrices, paint, instance paths and rand()). What it produces is up to a sink:
 //
 //  - povexport/expander.cpp: the expanded CSG tree, and the counting pass that sizes it;
@@ -34,20 +34,9 @@
 
 #include "eval.h"
 #include "graph.h"
+#include "semantics.h"
 
 namespace pcsg {
-
-// The argument values a primitive kind carries into an expanded tree.
-constexpr uint32_t storedArgs(PrimitiveKind k) {
-    switch (k) {
-        case PrimitiveKind::Torus:
-            return 2;
-        case PrimitiveKind::Triangle:
-            return 9;
-        default:
-            return 0;
-    }
-}
 
 // One node being visited: the traversal state the one semantics carries down.
 struct WalkEntry {
@@ -76,8 +65,11 @@ class Walker {
   public:
     using Result = typename Sink::Result;
 
-    Walker(const Graph& g, Sink& sink)
-        : g_(g), sink_(sink), frameSize_(std::max<size_t>(g.slotCount(), 1)) {}
+    Walker(const Semantics& sem, Sink& sink)
+        : g_(sem.graph()),
+          sem_(sem),
+          sink_(sink),
+          frameSize_(std::max<size_t>(sem.graph().slotCount(), 1)) {}
 
     // Walks everything below the axiom.
     Result run() {
@@ -125,6 +117,10 @@ class Walker {
             return false;
     }
 
+    PathState stateOf(const WalkEntry& e) const {
+        return PathState{arena_.data() + e.frame, e.path, e.depth, e.material};
+    }
+
     // The result of an S-node instance (in its own frame when localSelectFrames) as the
     // node above it sees it.
     Result fromSelect(const WalkEntry& e, const Result& r) {
@@ -136,125 +132,99 @@ class Walker {
 
     void step() {
         WalkEntry& e = stack_.back();
-        const Node& node = g_.nodes[e.node];
-        switch (node.kind) {
-            case NodeKind::Select: {
-                if (e.next == 0) {
-                    sink_.visit();
-                    const EvalState st{arena_.data() + e.frame, e.path};
-                    Result memo;
-                    if (sink_.lookup(e.node, e.depth, st.frame, e.path, memo)) {
-                        Result r = fromSelect(e, memo);
-                        stack_.pop_back();
-                        results_.push_back(r);
-                        return;
-                    }
-                    const uint32_t depth = e.depth + 1;
-                    checkDepth(g_, e.node, depth, st);
-                    const uint32_t rule = selectRule(g_, e.node, st);
-                    e.next = 1;
-                    WalkEntry c = e;
-                    c.node = g_.child(e.node, rule);
-                    c.next = 0;
-                    c.depth = depth;
-                    c.path = pathRule(e.path, rule);
-                    if constexpr (localSelectFrames()) c.world = Affine::identity();
-                    stack_.push_back(c);
-                } else {
-                    sink_.store(e.node, e.depth, arena_.data() + e.frame, e.path, results_.back());
-                    results_.back() = fromSelect(e, results_.back());
-                    stack_.pop_back();
-                }
-                return;
-            }
-            case NodeKind::Calc: {
-                if (e.next == 0) {
-                    sink_.visit();
-                    const size_t off = arena_.size();
-                    arena_.resize(off + frameSize_);
-                    WalkEntry& cur = stack_.back();
-                    applyCalc(g_, cur.node, {arena_.data() + cur.frame, cur.path},
-                              arena_.data() + off);
-                    cur.next = 1;
-                    WalkEntry c = cur;
-                    c.node = g_.child(cur.node);
-                    c.next = 0;
-                    c.frame = off;
-                    stack_.push_back(c);
-                } else {
-                    // Frames are released in stack order: the child's is the last one.
-                    arena_.resize(arena_.size() - frameSize_);
-                    stack_.pop_back();
-                }
-                return;
-            }
-            case NodeKind::Transform: {
-                if (e.next == 0) {
-                    sink_.visit();
-                    const Affine m = transformMatrix(g_, e.node, {arena_.data() + e.frame, e.path});
-                    e.next = 1;
-                    WalkEntry c = e;
-                    c.node = g_.child(e.node);
-                    c.next = 0;
-                    c.world = e.world * m;
-                    stack_.push_back(c);
-                } else {
-                    stack_.pop_back();
-                }
-                return;
-            }
-            case NodeKind::Paint: {
-                if (e.next == 0) {
-                    sink_.visit();
-                    e.next = 1;
-                    WalkEntry c = e;
-                    c.node = g_.child(e.node);
-                    c.next = 0;
-                    c.material = node.payload;
-                    stack_.push_back(c);
-                } else {
-                    stack_.pop_back();
-                }
-                return;
-            }
-            case NodeKind::Operator: {
-                if (e.next == 0) {
-                    sink_.visit();
-                    e.resultBase = results_.size();
-                    sink_.beginOperator(e);
-                }
-                if (e.next < node.childCount) {
-                    const uint32_t i = e.next++;
-                    WalkEntry c = e;
-                    c.node = g_.child(e.node, i);
-                    c.next = 0;
-                    c.path = pathChild(e.path, i);
-                    stack_.push_back(c);
-                    return;
-                }
-                const size_t base = e.resultBase;
-                const Result r =
-                    sink_.endOperator(node.op(), results_.data() + base,
-                                      static_cast<uint32_t>(results_.size() - base), e);
-                results_.resize(base);
-                results_.push_back(r);
-                stack_.pop_back();
-                return;
-            }
-            case NodeKind::Primitive: {
-                sink_.visit();
-                const Primitive& p = g_.primitives[node.payload];
-                double args[9] = {};
-                const uint32_t argc = storedArgs(p.kind);
-                if (argc) primitiveArgs(g_, e.node, {arena_.data() + e.frame, e.path}, args);
-                results_.push_back(sink_.primitive(p.kind, e.world, e.material, args, argc));
-                stack_.pop_back();
-                return;
-            }
+        switch (g_.nodes[e.node].kind) {
+            case NodeKind::Operator:
+                return stepOperator(e);
+            case NodeKind::Primitive:
+                return stepPrimitive(e);
+            default:
+                return e.next == 0 ? enterUnary(e) : leaveUnary(e);
         }
     }
 
+    // An S-node instance the sink has memoised: its result, without walking below.
+    bool memoised(const WalkEntry& e) {
+        Result memo;
+        if (!sink_.lookup(e.node, e.depth, arena_.data() + e.frame, e.path, memo)) return false;
+        Result r = fromSelect(e, memo);
+        stack_.pop_back();
+        results_.push_back(r);
+        return true;
+    }
+
+    // S, C, T and paint nodes on the way down: the one step of semantics.h.
+    void enterUnary(WalkEntry& e) {
+        sink_.visit();
+        const NodeKind kind = g_.nodes[e.node].kind;
+        if (kind == NodeKind::Select && memoised(e)) return;
+        StepScratch scratch;
+        size_t frame = e.frame;
+        if (kind == NodeKind::Calc) {
+            frame = arena_.size();
+            arena_.resize(frame + frameSize_);
+            scratch.frame = arena_.data() + frame;
+        }
+        const Step st = sem_.enter(e.node, stateOf(e), scratch);
+        e.next = 1;
+        WalkEntry c = e;
+        c.node = st.child;
+        c.next = 0;
+        c.frame = frame;
+        c.path = st.state.path;
+        c.depth = st.state.depth;
+        c.material = st.state.material;
+        if (st.forward) c.world = sem_.forwardThrough(e.world, e.node, st);
+        if (kind == NodeKind::Select && localSelectFrames()) c.world = Affine::identity();
+        stack_.push_back(c);
+    }
+
+    // ... and on the way back up.
+    void leaveUnary(WalkEntry& e) {
+        const NodeKind kind = g_.nodes[e.node].kind;
+        if (kind == NodeKind::Select) {
+            sink_.store(e.node, e.depth, arena_.data() + e.frame, e.path, results_.back());
+            results_.back() = fromSelect(e, results_.back());
+        }
+        // Frames are released in stack order: the C-node's child's is the last one.
+        if (kind == NodeKind::Calc) arena_.resize(arena_.size() - frameSize_);
+        stack_.pop_back();
+    }
+
+    void stepOperator(WalkEntry& e) {
+        const Node& node = g_.nodes[e.node];
+        if (e.next == 0) {
+            sink_.visit();
+            e.resultBase = results_.size();
+            sink_.beginOperator(e);
+        }
+        if (e.next < node.childCount) {
+            const uint32_t i = e.next++;
+            WalkEntry c = e;
+            c.node = g_.child(e.node, i);
+            c.next = 0;
+            c.path = Semantics::operand(stateOf(e), i).path;
+            stack_.push_back(c);
+            return;
+        }
+        const size_t base = e.resultBase;
+        const Result r = sink_.endOperator(node.op(), results_.data() + base,
+                                           static_cast<uint32_t>(results_.size() - base), e);
+        results_.resize(base);
+        results_.push_back(r);
+        stack_.pop_back();
+    }
+
+    void stepPrimitive(WalkEntry& e) {
+        sink_.visit();
+        double args[9] = {};
+        const uint32_t argc = sem_.primitiveArgs(e.node, stateOf(e), args);
+        const PrimitiveKind kind = g_.primitives[g_.nodes[e.node].payload].kind;
+        results_.push_back(sink_.primitive(kind, e.world, e.material, args, argc));
+        stack_.pop_back();
+    }
+
     const Graph& g_;
+    const Semantics& sem_;
     Sink& sink_;
     const size_t frameSize_;
     std::vector<WalkEntry> stack_;

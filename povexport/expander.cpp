@@ -245,7 +245,8 @@ std::string countText(uint64_t n) {
 
 ExpansionCount countExpansion(const Graph& g, const CountOptions& options) {
     CountSink sink(g, options.maxVisits);
-    Walker<CountSink> walker(g, sink);
+    const Semantics sem(g);
+    Walker<CountSink> walker(sem, sink);
     ExpansionCount out;
     try {
         const Count c = walker.run();
@@ -290,7 +291,8 @@ ExpandedTree expand(const Graph& g, const ExpandOptions& options) {
         tree.args.reserve(count.args);
     }
     TreeSink sink(tree, maxNodes);
-    Walker<TreeSink> walker(g, sink);
+    const Semantics sem(g);
+    Walker<TreeSink> walker(sem, sink);
     try {
         tree.root = walker.run();
     } catch (const OverBudget&) {

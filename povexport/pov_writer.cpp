@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "primitive_table.h"
+
 namespace pcsg {
 
 namespace {
@@ -35,26 +37,15 @@ Box diskBox(const Affine& m, double h) {
     return b;
 }
 
-void triangleCorners(const ExpandedTree& t, const TreePrimitive& p, Vec3 out[3]) {
-    switch (p.kind) {
-        case PrimitiveKind::Tri1:
-            out[0] = {0, 0, 0}, out[1] = {1, 0, 0}, out[2] = {0, 1, 0};
-            break;
-        case PrimitiveKind::Tri2:
-            out[0] = {0, 0, 0}, out[1] = {-1, 0, 0}, out[2] = {0, -1, 0};
-            break;
-        default: {
-            const double* a = t.args.data() + p.firstArg;
-            for (int k = 0; k < 3; ++k) out[k] = {a[3 * k], a[3 * k + 1], a[3 * k + 2]};
-        }
-    }
+// A triangle primitive's corners in world space.
+void worldCorners(const ExpandedTree& t, const TreePrimitive& p, Vec3 out[3]) {
+    triangleCorners(p.kind,
+                    p.kind == PrimitiveKind::Triangle ? t.args.data() + p.firstArg : nullptr, out);
     for (int k = 0; k < 3; ++k) out[k] = p.toWorld.point(out[k]);
 }
 
-constexpr Vec3 kTetraVertices[4] = {{1, 1, 1}, {-1, -1, 1}, {1, -1, -1}, {-1, 1, -1}};
-
 // A box that holds the primitive (tight for everything but the plane, which is infinite).
-Box primitiveBox(const ExpandedTree& t, const TreePrimitive& p) {
+Box worldBox(const ExpandedTree& t, const TreePrimitive& p) {
     const Affine& m = p.toWorld;
     Box b;
     switch (p.kind) {
@@ -95,7 +86,7 @@ Box primitiveBox(const ExpandedTree& t, const TreePrimitive& p) {
         case PrimitiveKind::Tri2:
         case PrimitiveKind::Triangle: {
             Vec3 c[3];
-            triangleCorners(t, p, c);
+            worldCorners(t, p, c);
             for (const Vec3& v : c) b.extend(v);
             return b;
         }
@@ -118,7 +109,7 @@ std::vector<Box> nodeBoxes(const ExpandedTree& t) {
     std::vector<Box> boxes(t.nodes.size());
     for (uint32_t n = 0; n < t.nodes.size(); ++n) {
         const TreeNode& node = t.nodes[n];
-        boxes[n] = node.primitive ? primitiveBox(t, t.primitiveOf(n))
+        boxes[n] = node.primitive ? worldBox(t, t.primitiveOf(n))
                                   : csgBox(node.op, node.count,
                                            [&](uint32_t i) { return boxes[t.childrenOf(n)[i]]; });
     }
@@ -292,27 +283,12 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p,
     const auto tex = [&] { o.put(" texture{{M{}}}", p.material); };
     switch (p.kind) {
         case PrimitiveKind::Sphere:
-            o.put("{}sphere{{<0,0,0>,1", indent);
-            tex();
-            putMatrix(o, p.toWorld);
-            break;
         case PrimitiveKind::Cube:
-            o.put("{}box{{<-1,-1,-1>,<1,1,1>", indent);
-            tex();
-            putMatrix(o, p.toWorld);
-            break;
         case PrimitiveKind::Cylinder:
-            o.put("{}cylinder{{<0,0,0>,<0,0,1>,1", indent);
-            tex();
-            putMatrix(o, p.toWorld);
-            break;
         case PrimitiveKind::Cone:
-            o.put("{}cone{{<0,0,0>,1,<0,0,1>,0", indent);
-            tex();
-            putMatrix(o, p.toWorld);
-            break;
         case PrimitiveKind::Tetrahedron:
-            o.put("{}object{{PcsgTetrahedron", indent);
+        case PrimitiveKind::Plane:
+            o.put("{}{}", indent, primitiveInfo(p.kind).pov);
             tex();
             putMatrix(o, p.toWorld);
             break;
@@ -324,16 +300,11 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p,
             tex();
             putMatrix(o, p.toWorld * torusFrame());
             break;
-        case PrimitiveKind::Plane:
-            o.put("{}plane{{<0,0,1>,0", indent);
-            tex();
-            putMatrix(o, p.toWorld);
-            break;
         case PrimitiveKind::Tri1:
         case PrimitiveKind::Tri2:
         case PrimitiveKind::Triangle: {
             Vec3 c[3];
-            triangleCorners(t, p, c);
+            worldCorners(t, p, c);
             if (degenerate(c)) return false;
             o.put("{}triangle{{", indent);
             o.vec(c[0]);

@@ -216,7 +216,7 @@ class BoxSink {
 
 class InstanceBoxes::Worker {
   public:
-    explicit Worker(const InstanceBoxes& boxes) : sink(boxes), walker(boxes.g_, sink) {}
+    explicit Worker(const InstanceBoxes& boxes) : sink(boxes), walker(boxes.sem_, sink) {}
     BoxSink sink;
     Walker<BoxSink> walker;
 };
@@ -226,6 +226,7 @@ class InstanceBoxes::Worker {
 InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
                              const InstanceBoxOptions& options)
     : g_(g),
+      sem_(g),
       bounds_(bounds),
       opt_(options),
       deps_(moduleDependencies(g)),
@@ -266,7 +267,7 @@ bool InstanceBoxes::useAt(NodeId select, uint32_t depth) const {
     return decision_[i].load(std::memory_order_relaxed) != 2;
 }
 
-bool InstanceBoxes::expandAt(NodeId select, uint32_t depth) const {
+bool InstanceBoxes::unrollAt(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return false;
     const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
     return expand_[i].load(std::memory_order_relaxed) != 0;
@@ -318,7 +319,7 @@ void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const
     if (tried >= opt_.trial) {
         const uint32_t paid = paid_[i].load(std::memory_order_relaxed);
         const bool expand = minWeight_[i].load(std::memory_order_relaxed) >= opt_.minExpandWeight &&
-                            maxWeight_[i].load(std::memory_order_relaxed) <= opt_.maxExpandWeight;
+                            maxWeight_[i].load(std::memory_order_relaxed) <= opt_.maxUnrollWeight;
         expand_[i].store(expand ? 1 : 0, std::memory_order_relaxed);
         decision_[i].store(paid * 2 >= tried ? 1 : 2, std::memory_order_relaxed);
     }

@@ -40,6 +40,7 @@
 #include "bounds.h"
 #include "geometry.h"
 #include "graph.h"
+#include "semantics.h"
 #include "walk.h"
 
 namespace pcsg::tracer {
@@ -54,9 +55,9 @@ struct InstanceBoxOptions {
     // some axis.
     double gain = 0.8;
     // Depths whose instances all took between these many visits to unroll are worth
-    // expanding (expanded_instances.h).
+    // expanding (unrolled_instances.h).
     uint64_t minExpandWeight = 12;
-    uint64_t maxExpandWeight = 8192;
+    uint64_t maxUnrollWeight = 8192;
 };
 
 struct InstanceBoxStats {
@@ -77,8 +78,8 @@ class InstanceBoxes {
     bool useAt(NodeId select, uint32_t depth) const;
     // Whether the instances of this S-node at this depth are worth expanding: decided
     // with useAt, from the sizes of the first instances met there.
-    bool expandAt(NodeId select, uint32_t depth) const;
-    uint64_t maxExpandWeight() const { return opt_.maxExpandWeight; }
+    bool unrollAt(NodeId select, uint32_t depth) const;
+    uint64_t maxUnrollWeight() const { return opt_.maxUnrollWeight; }
 
     // An instance: its S-node, the values of the parameters its sub-graph reads and, when
     // it calls rand() or choose(), its instance path, hashed to 128 bits.
@@ -116,6 +117,7 @@ class InstanceBoxes {
     void record(NodeId select, uint32_t depth, const Stored& s) const;
 
     const Graph& g_;
+    Semantics sem_;
     const Bounds& bounds_;
     InstanceBoxOptions opt_;
     std::vector<ModuleDependencies> deps_;

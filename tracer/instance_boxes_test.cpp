@@ -108,7 +108,7 @@ class SoundnessWalk {
                 const Primitive& p = g_.primitives[node.payload];
                 if (p.kind == PrimitiveKind::Empty) break;
                 double args[9] = {};
-                if (storedArgs(p.kind)) primitiveArgs(g_, n, st, args);
+                if (primitiveArgCount(p.kind)) primitiveArgs(g_, n, st, args);
                 Vec3 corners[3];
                 const bool triangle = isTriangle(p.kind);
                 if (triangle) triangleCorners(p.kind, args, corners);

@@ -374,51 +374,6 @@ bool intersectTriangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& 
     return true;
 }
 
-void triangleCorners(PrimitiveKind kind, const double* args, Vec3 corners[3]) {
-    switch (kind) {
-        case PrimitiveKind::Tri1:
-            corners[0] = {0, 0, 0}, corners[1] = {1, 0, 0}, corners[2] = {0, 1, 0};
-            return;
-        case PrimitiveKind::Tri2:
-            corners[0] = {0, 0, 0}, corners[1] = {-1, 0, 0}, corners[2] = {0, -1, 0};
-            return;
-        default:
-            for (int i = 0; i < 3; ++i)
-                corners[i] = {args[3 * i], args[3 * i + 1], args[3 * i + 2]};
-            return;
-    }
-}
-
-Box primitiveBox(PrimitiveKind kind, const double* args) {
-    switch (kind) {
-        case PrimitiveKind::Sphere:
-        case PrimitiveKind::Cube:
-        case PrimitiveKind::Tetrahedron:
-            return Box{{-1, -1, -1}, {1, 1, 1}};
-        case PrimitiveKind::Cylinder:
-        case PrimitiveKind::Cone:
-            return Box{{-1, -1, 0}, {1, 1, 1}};
-        case PrimitiveKind::Torus: {
-            const double e = std::fabs(args[0]) + std::fabs(args[1]), r = std::fabs(args[1]);
-            return Box{{-e, -e, -r}, {e, e, r}};
-        }
-        case PrimitiveKind::Plane:
-            return Box{{-kInf, -kInf, -kInf}, {kInf, kInf, 0}};
-        case PrimitiveKind::Empty:
-            return Box::empty();
-        case PrimitiveKind::Tri1:
-        case PrimitiveKind::Tri2:
-        case PrimitiveKind::Triangle: {
-            Vec3 c[3];
-            triangleCorners(kind, args, c);
-            Box b;
-            for (const Vec3& p : c) b.extend(p);
-            return b;
-        }
-    }
-    return Box::everything();
-}
-
 bool insideSolid(PrimitiveKind kind, const double* args, const Vec3& p) {
     switch (kind) {
         case PrimitiveKind::Sphere:

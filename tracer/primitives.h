@@ -12,6 +12,7 @@
 
 #include "geometry.h"
 #include "graph.h"
+#include "primitive_table.h"
 
 namespace pcsg::tracer {
 
@@ -37,17 +38,6 @@ int intersectSolid(PrimitiveKind kind, const double* args, const Vec3& origin, c
 // The triangle (a, b, c) hit with t in (tmin, tmax): the normal is (b - a) x (c - a).
 bool intersectTriangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& origin,
                        const Vec3& dir, double tmin, double tmax, Boundary& hit);
-
-// The corners of tri1, tri2 or triangle(x1..z3).
-void triangleCorners(PrimitiveKind kind, const double* args, Vec3 corners[3]);
-
-// True for the surfaces tri1, tri2, triangle.
-constexpr bool isTriangle(PrimitiveKind k) {
-    return k == PrimitiveKind::Tri1 || k == PrimitiveKind::Tri2 || k == PrimitiveKind::Triangle;
-}
-
-// The primitive's bounding box in its own coordinates (torus: from R and r).
-Box primitiveBox(PrimitiveKind kind, const double* args);
 
 // Inside test for the solids (points on the surface count as inside), for tests.
 bool insideSolid(PrimitiveKind kind, const double* args, const Vec3& p);

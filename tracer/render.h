@@ -41,7 +41,7 @@ struct RenderOptions {
     // kept in a table of at most this many bytes.
     bool instanceBoxes = true;
     size_t instanceBoxBytes = 64u << 20;
-    // Expanded instances (expanded_instances.h), each thread's cache holding at most this
+    // Expanded instances (unrolled_instances.h), each thread's cache holding at most this
     // many bytes; 0: none.
     size_t expansionBytesPerThread = 16u << 20;
     // Called from worker threads with the fraction done (0..1); may be empty.

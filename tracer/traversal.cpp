@@ -45,28 +45,11 @@ uintptr_t threadStackLimit() {
 
 TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
                        const InstanceBoxOptions& instanceBoxOptions)
-    : g_(g), bounds_(std::move(bounds)) {
+    : g_(g), sem_(g), bounds_(std::move(bounds)) {
     const size_t n = g.nodes.size();
     if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
     if (useInstanceBoxes && !g.modules.empty())
         instanceBoxes_ = std::make_unique<InstanceBoxes>(g, bounds_, instanceBoxOptions);
-    inverse_.assign(n, Affine::identity());
-    target_.assign(n, kNone);
-    auto constantT = [&](NodeId m) {
-        return g.nodes[m].kind == NodeKind::Transform && g.transforms[g.nodes[m].payload].constant;
-    };
-    for (NodeId m = 0; m < n; ++m) {
-        if (!constantT(m)) continue;
-        // Fuse the chain of constant T-nodes below m: inverse of M_m M_c1 ... M_ck.
-        Affine inv = g.transforms[g.nodes[m].payload].matrix.inverse();
-        NodeId c = g.child(m);
-        for (size_t guard = 0; constantT(c) && guard < n; ++guard) {
-            inv = g.transforms[g.nodes[c].payload].matrix.inverse() * inv;
-            c = g.child(c);
-        }
-        inverse_[m] = inv;
-        target_[m] = c;
-    }
     // Longest chain of nested visits between two S-nodes (the graph without the edges into
     // S-nodes is acyclic), then the whole walk's bound.
     std::vector<uint32_t> indeg(n, 0), order;
@@ -126,16 +109,16 @@ Tracer::Tracer(const TraceScene& scene)
     initFrame(g_, rootFrame_.data());
     if (scene.instanceBoxes_) boxWorker_ = scene.instanceBoxes_->makeWorker();
     if (scene.instanceBoxes_ && scene.expansionBytesPerThread > 0)
-        expansion_ = std::make_unique<ExpansionCache>(scene, scene.expansionBytesPerThread);
+        expansion_ = std::make_unique<UnrollCache>(scene, scene.expansionBytesPerThread);
 }
 
 Tracer::~Tracer() = default;
 
-// The expanded instance to trace instead of walking below S-node n, if there is one.
-const ExpandedInstance* Tracer::expandedAt(NodeId n, const Ctx& c, uint32_t depth) {
-    if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->expandAt(n, depth))
+// The unrolled instance to trace instead of walking below S-node n, if there is one.
+const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t depth) {
+    if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->unrollAt(n, depth))
         return nullptr;
-    const ExpandedInstance* x = expansion_->get(n, depth, c.frame, c.path);
+    const UnrolledInstance* x = expansion_->get(n, depth, c.frame, c.path);
     // Used only where its deepest S-node stays within max_depth (else the walk reports it).
     if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
     return x;
@@ -196,61 +179,45 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
     return walk(origin, dir, tmin, tmax, hit);
 }
 
-// The unary nodes on the way down, shared by first() and spans(): an S-node selects its
-// rule (or is culled by its boxes, or hands the ray to an expanded instance), a C-node
-// computes a new frame, a T-node maps the ray into its child's frame, paint sets the
-// material. `below(node, ray, ctx)` walks on from the node they lead to; `expanded(x,
-// ctx)` traces an expanded instance instead; `transformBack(inv, walkBelow)` runs the
-// walk below a T-node and brings the normals it found back through the T-node.
-template <class Below, class Expanded, class TransformBack>
+// The unary nodes on the way down, shared by first() and spans(): the one step of
+// semantics.h, after an S-node's culling by its boxes (or the hand-over to an unrolled
+// instance), with the ray mapped into a T-node's child's frame. `below(node, ray, state)`
+// walks on from the node the step leads to; `unrolled(x, state)` traces an unrolled
+// instance instead; `transformBack(inv, walkBelow)` runs the walk below a T-node and
+// brings the normals it found back through the T-node.
+template <class Below, class Unrolled, class TransformBack>
 auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
-                   Expanded expanded, TransformBack transformBack) {
+                   Unrolled unrolled, TransformBack transformBack) {
     using Result = decltype(below(n, r, c));
-    const Node& node = g_.nodes[n];
-    switch (node.kind) {
-        case NodeKind::Select: {
-            const uint32_t depth = c.depth + 1;
-            const EvalState st{c.frame, c.path};
-            try {
-                checkDepth(g_, n, depth, st);
-                checkStack();
-                if (selectCulled(n, r, c, depth, tmin, tmax)) return Result{};
-                if (const ExpandedInstance* x = expandedAt(n, c, depth)) return expanded(*x, c);
-                const uint32_t rule = selectRule(g_, n, st);
-                return below(g_.child(n, rule), r,
-                             Ctx{c.frame, pathRule(c.path, rule), depth, c.material});
-            } catch (RuntimeError& e) {
-                e.enterModule(g_.modules[node.payload].name);
-                throw;
-            }
+    const Semantics& sem = scene_.sem_;
+    const NodeKind kind = g_.nodes[n].kind;
+    StepScratch scratch;
+    if (kind == NodeKind::Select) {
+        try {
+            const uint32_t depth = sem.selectDepth(n, c);
+            checkStack();
+            if (selectCulled(n, r, c, depth, tmin, tmax)) return Result{};
+            if (const UnrolledInstance* x = unrolledAt(n, c, depth)) return unrolled(*x, c);
+            const Step st = sem.enter(n, c, scratch);
+            return below(st.child, r, st.state);
+        } catch (RuntimeError& e) {
+            e.enterModule(g_.modules[g_.nodes[n].payload].name);
+            throw;
         }
-        case NodeKind::Calc: {
-            double* f = frames_.push();
-            applyCalc(g_, n, EvalState{c.frame, c.path}, f);
-            const Result found = below(g_.child(n), r, Ctx{f, c.path, c.depth, c.material});
-            frames_.pop();
-            return found;
-        }
-        case NodeKind::Transform: {
-            NodeId target = scene_.target_[n];
-            Affine computed;
-            const Affine* inv = &scene_.inverse_[n];
-            if (target == kNone) {
-                computed = transformMatrix(g_, n, EvalState{c.frame, c.path}).inverse();
-                inv = &computed;
-                target = g_.child(n);
-            }
-            const LocalRay rr{inv->point(r.o), inv->vector(r.d)};
-            return transformBack(*inv, [&] { return below(target, rr, c); });
-        }
-        case NodeKind::Paint:
-            return below(g_.child(n), r, Ctx{c.frame, c.path, c.depth, node.payload});
-        default:
-            return Result{};  // not a unary node
     }
+    if (kind == NodeKind::Calc) scratch.frame = frames_.push();
+    const Step st = sem.enter(n, c, scratch);
+    Result found;
+    if (st.inverse) {
+        const LocalRay rr{st.inverse->point(r.o), st.inverse->vector(r.d)};
+        found = transformBack(*st.inverse, [&] { return below(st.child, rr, st.state); });
+    } else {
+        found = below(st.child, r, st.state);
+    }
+    if (kind == NodeKind::Calc) frames_.pop();
+    return found;
 }
 
-// The first boundary of the span list of an intersection or a difference.
 bool Tracer::firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
                           Hit& hit) {
     const size_t base = spans_.size();
@@ -274,7 +241,7 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 [&](NodeId below, const LocalRay& rr, const Ctx& cc) {
                     return first(below, rr, cc, tmin, tmax, hit);
                 },
-                [&](const ExpandedInstance& x, const Ctx& cc) {
+                [&](const UnrolledInstance& x, const Ctx& cc) {
                     return x.first(r, tmin, tmax, hit, {cc.path, cc.material}, anyHit_,
                                    expansion_->scratch());
                 },
@@ -293,40 +260,41 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                            clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, t0, t1);
                 },
                 [&](uint32_t i, double& best, Hit& h) {
-                    const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
-                    return first(g_.child(n, i), r, cc, tmin, best, h);
+                    return first(g_.child(n, i), r, Semantics::operand(c, i), tmin, best, h);
                 });
-        case NodeKind::Primitive: {
-            const Primitive& p = g_.primitives[node.payload];
-            double args[9] = {};
-            if (p.kind == PrimitiveKind::Torus || isTriangle(p.kind))
-                primitiveArgs(g_, n, EvalState{c.frame, c.path}, args);
-            if (isTriangle(p.kind)) {
-                Vec3 corners[3];
-                triangleCorners(p.kind, args, corners);
-                Boundary b;
-                // (tmax widened by one step so that a tie can be seen)
-                if (!intersectTriangle(corners[0], corners[1], corners[2], r.o, r.d, tmin,
-                                       std::nextafter(tmax, kInfinity), b) ||
-                    !nearer(b.t, c.path, tmax, hit))
-                    return false;
-                hit = Hit{b.t, b.normal, c.material, true, c.path};
-                tmax = b.t;
-                return true;
-            }
-            Span s[kMaxPrimitiveSpans];
-            const int count = intersectSolid(p.kind, args, r.o, r.d, s);
-            for (int k = 0; k < count; ++k) {
-                const Boundary* b =
-                    s[k].in.t > tmin ? &s[k].in : (s[k].out.t > tmin ? &s[k].out : nullptr);
-                if (!b) continue;
-                if (!nearer(b->t, c.path, tmax, hit)) return false;
-                hit = Hit{b->t, b->normal, c.material, true, c.path};
-                tmax = b->t;
-                return true;
-            }
+        case NodeKind::Primitive:
+            return firstOfPrimitive(n, r, c, tmin, tmax, hit);
+    }
+    return false;
+}
+
+bool Tracer::firstOfPrimitive(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
+                              Hit& hit) {
+    const PrimitiveKind kind = g_.primitives[g_.nodes[n].payload].kind;
+    double args[9] = {};
+    scene_.sem_.primitiveArgs(n, c, args);
+    if (isTriangle(kind)) {
+        Vec3 corners[3];
+        triangleCorners(kind, args, corners);
+        Boundary b;
+        // (tmax widened by one step so that a tie can be seen)
+        if (!intersectTriangle(corners[0], corners[1], corners[2], r.o, r.d, tmin,
+                               std::nextafter(tmax, kInfinity), b) ||
+            !nearer(b.t, c.path, tmax, hit))
             return false;
-        }
+        hit = Hit{b.t, b.normal, c.material, true, c.path};
+        tmax = b.t;
+        return true;
+    }
+    Span s[kMaxPrimitiveSpans];
+    const int count = intersectSolid(kind, args, r.o, r.d, s);
+    for (int k = 0; k < count; ++k) {
+        const Boundary* b = s[k].in.t > tmin ? &s[k].in : (s[k].out.t > tmin ? &s[k].out : nullptr);
+        if (!b) continue;
+        if (!nearer(b->t, c.path, tmax, hit)) return false;
+        hit = Hit{b->t, b->normal, c.material, true, c.path};
+        tmax = b->t;
+        return true;
     }
     return false;
 }
@@ -344,7 +312,7 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
                 [&](NodeId below, const LocalRay& rr, const Ctx& cc) {
                     return spans(below, rr, cc, tmin, tmax);
                 },
-                [&](const ExpandedInstance& x, const Ctx& cc) {
+                [&](const UnrolledInstance& x, const Ctx& cc) {
                     return x.spans(r, tmin, tmax, spans_, {cc.path, cc.material},
                                    expansion_->scratch());
                 },
@@ -365,15 +333,13 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
                            clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, lo, hi);
                 },
                 [&](uint32_t i, double lo, double hi) {
-                    const Ctx cc{c.frame, pathChild(c.path, i), c.depth, c.material};
-                    return spans(g_.child(n, i), r, cc, lo, hi);
+                    return spans(g_.child(n, i), r, Semantics::operand(c, i), lo, hi);
                 });
         case NodeKind::Primitive: {
             const Primitive& p = g_.primitives[node.payload];
             if (isTriangle(p.kind)) return 0;  // surfaces: never under ∩ or \ (the compiler checks)
             double args[9] = {};
-            if (p.kind == PrimitiveKind::Torus)
-                primitiveArgs(g_, n, EvalState{c.frame, c.path}, args);
+            scene_.sem_.primitiveArgs(n, c, args);
             Span s[kMaxPrimitiveSpans];
             const int count = intersectSolid(p.kind, args, r.o, r.d, s);
             for (int k = 0; k < count; ++k) {

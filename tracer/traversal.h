@@ -19,7 +19,7 @@
 //    loose, an S-node also tests the exact box of the instance at hand
 //    (instance_boxes.h: a lazily filled, memory-bounded cache).
 //  - Small instances that rays keep meeting are expanded once per thread
-//    (expanded_instances.h) and traced as flat arrays with the same matrices, so the
+//    (unrolled_instances.h) and traced as flat arrays with the same matrices, so the
 //    walk below them finds the same surfaces bit for bit without re-evaluating them.
 //  - Ties: of two surfaces at exactly the same distance, the one with the smaller
 //    instance path wins, whatever the order the walk found them in. So the image does
@@ -43,11 +43,12 @@
 
 #include "bounds.h"
 #include "eval.h"
-#include "expanded_instances.h"
 #include "graph.h"
 #include "instance_boxes.h"
 #include "operators.h"
 #include "primitives.h"
+#include "semantics.h"
+#include "unrolled_instances.h"
 
 namespace pcsg::tracer {
 
@@ -57,8 +58,8 @@ struct SurfaceHit {
     uint32_t material = 0;
 };
 
-// The graph with everything the walk precomputes once: boxes, inverses of constant
-// T-node matrices (fused along chains of constant T-nodes), the recursion bound.
+// The graph with everything the walk precomputes once: its semantics (with the fused
+// chains of constant T-nodes), boxes, the recursion bound.
 class TraceScene {
   public:
     TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes = true,
@@ -78,21 +79,18 @@ class TraceScene {
     // The exact boxes of instances (nullptr: static boxes only).
     const InstanceBoxes* instanceBoxes() const { return instanceBoxes_.get(); }
 
-    // Expanded instances (expanded_instances.h): each tracer's cache may hold this many
+    // Expanded instances (unrolled_instances.h): each tracer's cache may hold this many
     // bytes; 0 turns them off.
     size_t expansionBytesPerThread = 16u << 20;
 
-    // How the walk applies T-node n: when n starts a chain of constant T-nodes, the chain's
-    // end and the inverse of the chain's product (as one matrix); else kNone.
-    NodeId fusedTarget(NodeId n) const { return target_[n]; }
-    const Affine& fusedInverse(NodeId n) const { return inverse_[n]; }
+    // What entering each node means (with the fused chains of constant T-nodes).
+    const Semantics& semantics() const { return sem_; }
 
   private:
     friend class Tracer;
     const Graph& g_;
+    Semantics sem_;
     Bounds bounds_;
-    std::vector<Affine> inverse_;  // per node: constant T-nodes (fused chain)
-    std::vector<NodeId> target_;   // per node: where a constant T-chain leads, else kNone
     uint64_t recursionBound_ = 0;
     std::unique_ptr<InstanceBoxes> instanceBoxes_;
 };
@@ -130,12 +128,7 @@ class Tracer {
     uintptr_t stackLowWater() const { return lowWater_; }
 
   private:
-    struct Ctx {
-        const double* frame;
-        uint64_t path;
-        uint32_t depth;
-        uint32_t material;
-    };
+    using Ctx = PathState;
 
     // Parameter frames: a stack of fixed-size blocks (addresses stay valid while deeper
     // frames are pushed).
@@ -153,15 +146,17 @@ class Tracer {
     };
 
     bool first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit);
+    bool firstOfPrimitive(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
+                          Hit& hit);
     bool firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
                       Hit& hit);
     size_t spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax);
     bool selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
                       double tmax);
-    const ExpandedInstance* expandedAt(NodeId n, const Ctx& c, uint32_t depth);
-    template <class Below, class Expanded, class TransformBack>
+    const UnrolledInstance* unrolledAt(NodeId n, const Ctx& c, uint32_t depth);
+    template <class Below, class Unrolled, class TransformBack>
     auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
-               Expanded expanded, TransformBack transformBack);
+               Unrolled unrolled, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
     void checkStack();
 
@@ -169,7 +164,7 @@ class Tracer {
     const Graph& g_;
     FrameStack frames_;
     InstanceBoxes::WorkerPtr boxWorker_;
-    std::unique_ptr<ExpansionCache> expansion_;
+    std::unique_ptr<UnrollCache> expansion_;
     std::vector<double> rootFrame_;
     std::vector<Span> spans_;
     std::vector<std::pair<double, uint32_t>> order_;

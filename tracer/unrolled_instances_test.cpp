@@ -1,7 +1,7 @@
-// Expanded instances (expanded_instances.h): a ray finds the same surface, bit for bit,
+// Expanded instances (unrolled_instances.h): a ray finds the same surface, bit for bit,
 // through an expanded instance as through the walk of the graph; materials and ties
 // depend on where an instance is used; the cache stays within its budget.
-#include "expanded_instances.h"
+#include "unrolled_instances.h"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +21,7 @@ InstanceBoxOptions eager() {
     InstanceBoxOptions o;
     o.trial = 1;
     o.minExpandWeight = 1;
-    o.maxExpandWeight = 1u << 20;
+    o.maxUnrollWeight = 1u << 20;
     return o;
 }
 
@@ -154,13 +154,13 @@ TEST(ExpandedInstances, AChainOfUnionsGetsAHierarchyAndTheSameHits) {
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
     TraceScene scene(g, computeBounds(g), true, eager());
-    ExpansionCache cache(scene, 1u << 20);
+    UnrollCache cache(scene, 1u << 20);
     std::vector<double> root(g.slotCount()), frame(g.slotCount());
     initFrame(g, root.data());
     applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, frame.data());
     const NodeId s = g.child(g.axiom);
     EXPECT_EQ(cache.get(s, 1, frame.data(), kRootPath), nullptr);  // the first meeting: a note
-    const ExpandedInstance* x = cache.get(s, 1, frame.data(), kRootPath);
+    const UnrolledInstance* x = cache.get(s, 1, frame.data(), kRootPath);
     ASSERT_NE(x, nullptr);
     // 22 primitives under one hierarchy: at least 22 / 4 leaves.
     EXPECT_GE(x->bvhNodes(), 6u);

@@ -14,7 +14,7 @@
 // changes an image, and the cache can keep whatever pays.
 //
 //  - Which instances: those at the depths where InstanceBoxes has seen sub-graphs of a
-//    few dozen to a thousand node visits (InstanceBoxes::expandAt); the first S-node of
+//    few dozen to a thousand node visits (InstanceBoxes::unrollAt); the first S-node of
 //    such a depth on a ray's path is expanded with everything below it.
 //  - When: an instance is expanded the second time a thread meets it (the first time
 //    only leaves a note), so that instances a single ray passes do not pay for it; and a
@@ -41,7 +41,7 @@ namespace pcsg::tracer {
 
 class TraceScene;
 
-class ExpandedInstance {
+class UnrolledInstance {
   public:
     static constexpr uint32_t kInherit = UINT32_MAX;  // material: the caller's
 
@@ -99,7 +99,7 @@ class ExpandedInstance {
     size_t bvhNodes() const { return bvh_.size(); }
 
   private:
-    friend class ExpansionBuilder;
+    friend class Unroller;
 
     bool firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
                  bool anyHit, Scratch& s) const;
@@ -125,17 +125,17 @@ class ExpandedInstance {
 };
 
 // One thread's cache of expanded instances.
-class ExpansionCache {
+class UnrollCache {
   public:
-    ExpansionCache(const TraceScene& scene, size_t maxBytes);
-    ~ExpansionCache();
+    UnrollCache(const TraceScene& scene, size_t maxBytes);
+    ~UnrollCache();
 
     // The expanded instance of the S-node instance (select, frame, path) at `depth`, or
     // nullptr (not worth expanding yet, or too large). Throws RuntimeError (without this
     // S-node in its module path) when unrolling meets a run-time error.
-    const ExpandedInstance* get(NodeId select, uint32_t depth, const double* frame, uint64_t path);
+    const UnrolledInstance* get(NodeId select, uint32_t depth, const double* frame, uint64_t path);
 
-    ExpandedInstance::Scratch& scratch() { return scratch_; }
+    UnrolledInstance::Scratch& scratch() { return scratch_; }
     uint64_t expansions() const { return expansions_; }
     size_t bytes() const { return bytes_; }
     size_t entries() const { return lru_.size(); }
@@ -143,7 +143,7 @@ class ExpansionCache {
   private:
     struct Entry {
         InstanceBoxes::Key key;
-        std::unique_ptr<ExpandedInstance> instance;  // nullptr: met once, or too large
+        std::unique_ptr<UnrolledInstance> instance;  // nullptr: met once, or too large
         bool tooLarge = false;
         size_t bytes = 0;
     };
@@ -166,7 +166,7 @@ class ExpansionCache {
     uint64_t expansions_ = 0;
     std::list<Entry> lru_;  // most recently used first
     std::unordered_map<InstanceBoxes::Key, std::list<Entry>::iterator, KeyHash> index_;
-    ExpandedInstance::Scratch scratch_;
+    UnrolledInstance::Scratch scratch_;
 };
 
 }  // namespace pcsg::tracer

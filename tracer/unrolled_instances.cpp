@@ -1,5 +1,5 @@
-// Expanded instances: see expanded_instances.h.
-#include "expanded_instances.h"
+// Expanded instances: see unrolled_instances.h.
+#include "unrolled_instances.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,8 +15,8 @@ namespace {
 
 constexpr uint32_t kRuleBit = 1u << 31;
 
-bool isUnion(const ExpandedInstance::Node& n) {
-    return n.kind == ExpandedInstance::Kind::Operator && n.op == CsgOp::Union;
+bool isUnion(const UnrolledInstance::Node& n) {
+    return n.kind == UnrolledInstance::Kind::Operator && n.op == CsgOp::Union;
 }
 
 // The expansion took more visits than its depth promised: leave it to the graph walk.
@@ -25,22 +25,23 @@ struct TooLarge {};
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
-// Building: a walk of the graph below one S-node instance that mirrors the tracer's walk
-// (traversal.cpp) exactly: the same selections, C-nodes and T-node inverses (fused along
-// constant chains as TraceScene fuses them), in the same order.
+// Building: a walk of the graph below one S-node instance that takes the tracer's steps
+// (semantics.h: the same selections, C-nodes and T-node inverses, fused along constant
+// chains), in the same order, and keeps what it meets in flat arrays.
 
-class ExpansionBuilder {
+class Unroller {
   public:
-    ExpansionBuilder(const TraceScene& scene, ExpandedInstance& out, uint64_t maxVisits)
-        : scene_(scene), g_(scene.graph()), out_(out), maxVisits_(maxVisits) {}
+    Unroller(const TraceScene& scene, UnrolledInstance& out, uint64_t maxVisits)
+        : sem_(scene.semantics()), g_(scene.graph()), out_(out), maxVisits_(maxVisits) {}
 
     void run(NodeId select, uint32_t depth, const double* frame, uint64_t path) {
         frames_.emplace_back(frame, frame + g_.slotCount());
         const uint32_t rule = selectRule(g_, select, EvalState{frame, path});
         choices_.push_back(kRuleBit | rule);
         base_ = depth;
-        out_.root_ = build(g_.child(select, rule), 0, pathRule(path, rule), depth,
-                           ExpandedInstance::kInherit, 0, Affine::identity());
+        const PathState s{frames_[0].data(), pathRule(path, rule), depth,
+                          UnrolledInstance::kInherit};
+        out_.root_ = build(g_.child(select, rule), s, 0, Affine::identity());
         if (out_.root_ != kNone) hierarchy(out_.root_);
         out_.nodes_.shrink_to_fit();
         out_.bvh_.shrink_to_fit();
@@ -52,124 +53,101 @@ class ExpansionBuilder {
     }
 
   private:
-    using Node = ExpandedInstance::Node;
-    using Kind = ExpandedInstance::Kind;
-    using BvhNode = ExpandedInstance::BvhNode;
+    using Node = UnrolledInstance::Node;
+    using Kind = UnrolledInstance::Kind;
+    using BvhNode = UnrolledInstance::BvhNode;
 
-    // Builds what node n holds; returns its index, or kNone when it holds nothing. The
-    // inverse matrices in pending_[pendingBase..] and the forward map `edge` lead from
-    // the frame of the last operator above (or the S-node) to n's frame.
-    uint32_t build(NodeId n, size_t frame, uint64_t path, uint32_t depth, uint32_t material,
-                   size_t pendingBase, const Affine& edge) {
+    // Builds what node n holds in state s; returns its index, or kNone when it holds
+    // nothing. The inverse matrices in pending_[pendingBase..] and the forward map `edge`
+    // lead from the frame of the last operator above (or the S-node) to n's frame.
+    uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
         if (++visits_ > maxVisits_) throw TooLarge{};
-        const ::pcsg::Node& node = g_.nodes[n];
-        switch (node.kind) {
-            case NodeKind::Select: {
-                const uint32_t d = depth + 1;
-                const EvalState st{frames_[frame].data(), path};
+        switch (g_.nodes[n].kind) {
+            case NodeKind::Operator:
+                return buildOperator(n, s, pendingBase, edge);
+            case NodeKind::Primitive:
+                return buildPrimitive(n, s, pendingBase, edge);
+            case NodeKind::Select:
                 try {
-                    checkDepth(g_, n, d, st);
-                    out_.levels_ = std::max(out_.levels_, d - base_);
-                    const uint32_t rule = selectRule(g_, n, st);
-                    choices_.push_back(kRuleBit | rule);
-                    const uint32_t r = build(g_.child(n, rule), frame, pathRule(path, rule), d,
-                                             material, pendingBase, edge);
-                    choices_.pop_back();
-                    return r;
+                    return buildUnary(n, s, pendingBase, edge);
                 } catch (RuntimeError& e) {
-                    e.enterModule(g_.modules[node.payload].name);
+                    e.enterModule(g_.modules[g_.nodes[n].payload].name);
                     throw;
                 }
-            }
-            case NodeKind::Calc: {
-                std::vector<double> next(g_.slotCount());
-                applyCalc(g_, n, EvalState{frames_[frame].data(), path}, next.data());
-                frames_.push_back(std::move(next));
-                const uint32_t r = build(g_.child(n), frames_.size() - 1, path, depth, material,
-                                         pendingBase, edge);
-                frames_.pop_back();
-                return r;
-            }
-            case NodeKind::Transform: {
-                // As Tracer::first: a fused constant chain, or this T-node's inverse.
-                NodeId target = scene_.fusedTarget(n);
-                Affine inverse, forward;
-                if (target != kNone) {
-                    inverse = scene_.fusedInverse(n);
-                    forward = Affine::identity();
-                    for (NodeId m = n; m != target; m = g_.child(m))
-                        forward = forward * g_.transforms[g_.nodes[m].payload].matrix;
-                } else {
-                    forward = transformMatrix(g_, n, EvalState{frames_[frame].data(), path});
-                    inverse = forward.inverse();
-                    target = g_.child(n);
-                }
-                pending_.push_back(inverse);
-                const uint32_t r =
-                    build(target, frame, path, depth, material, pendingBase, edge * forward);
-                pending_.pop_back();
-                return r;
-            }
-            case NodeKind::Paint:
-                return build(g_.child(n), frame, path, depth, node.payload, pendingBase, edge);
-            case NodeKind::Operator: {
-                const CsgOp op = node.op();
-                std::vector<uint32_t> kids;
-                const size_t mark = pending_.size();
-                for (uint32_t i = 0; i < node.childCount; ++i) {
-                    choices_.push_back(i);
-                    const uint32_t c = build(g_.child(n, i), frame, pathChild(path, i), depth,
-                                             material, mark, Affine::identity());
-                    choices_.pop_back();
-                    if (c == kNone) {
-                        if (emptyOperandEmptiesAll(op, i)) return kNone;
-                        continue;
-                    }
-                    kids.push_back(c);
-                }
-                if (kids.empty()) return kNone;
-                Box inside = out_.nodes_[kids[0]].box;
-                for (size_t k = 1; k < kids.size(); ++k) {
-                    const Box& b = out_.nodes_[kids[k]].box;
-                    if (op == CsgOp::Union) inside.extend(b);
-                    if (op == CsgOp::Intersection) inside = intersect(inside, b);
-                }
-                Node x = emit(Kind::Operator, material, pendingBase, edge, inside);
-                x.op = op;
-                x.first = static_cast<uint32_t>(out_.children_.size());
-                x.count = static_cast<uint32_t>(kids.size());
-                out_.children_.insert(out_.children_.end(), kids.begin(), kids.end());
-                if (op != CsgOp::Union) setChoices(x);
-                out_.nodes_.push_back(x);
-                return static_cast<uint32_t>(out_.nodes_.size() - 1);
-            }
-            case NodeKind::Primitive: {
-                const Primitive& p = g_.primitives[node.payload];
-                if (p.kind == PrimitiveKind::Empty) return kNone;
-                double args[9] = {};
-                const uint32_t argc = storedArgs(p.kind);
-                if (p.kind == PrimitiveKind::Torus || isTriangle(p.kind))
-                    primitiveArgs(g_, n, EvalState{frames_[frame].data(), path}, args);
-                Box own;
-                if (isTriangle(p.kind)) {
-                    Vec3 corners[3];
-                    triangleCorners(p.kind, args, corners);
-                    for (const Vec3& c : corners) own.extend(c);
-                } else {
-                    own = primitiveBox(p.kind, args);
-                }
-                Node x = emit(isTriangle(p.kind) ? Kind::Triangle : Kind::Solid, material,
-                              pendingBase, edge, own);
-                x.prim = p.kind;
-                x.first = static_cast<uint32_t>(out_.args_.size());
-                x.count = argc;
-                out_.args_.insert(out_.args_.end(), args, args + argc);
-                setChoices(x);
-                out_.nodes_.push_back(x);
-                return static_cast<uint32_t>(out_.nodes_.size() - 1);
-            }
+            default:
+                return buildUnary(n, s, pendingBase, edge);
         }
-        return kNone;
+    }
+
+    // S, C, T and paint nodes: the one step of semantics.h, as the tracer's walk takes it.
+    uint32_t buildUnary(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+        const NodeKind kind = g_.nodes[n].kind;
+        StepScratch scratch;
+        if (kind == NodeKind::Calc) {
+            frames_.emplace_back(g_.slotCount());
+            scratch.frame = frames_.back().data();
+        }
+        const Step st = sem_.enter(n, s, scratch);
+        if (kind == NodeKind::Select) {
+            out_.levels_ = std::max(out_.levels_, st.state.depth - base_);
+            choices_.push_back(kRuleBit | st.rule);
+        }
+        if (st.inverse) pending_.push_back(*st.inverse);
+        const uint32_t r =
+            build(st.child, st.state, pendingBase, st.forward ? edge * *st.forward : edge);
+        if (st.inverse) pending_.pop_back();
+        if (kind == NodeKind::Select) choices_.pop_back();
+        if (kind == NodeKind::Calc) frames_.pop_back();
+        return r;
+    }
+
+    uint32_t buildOperator(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+        const ::pcsg::Node& node = g_.nodes[n];
+        const CsgOp op = node.op();
+        std::vector<uint32_t> kids;
+        const size_t mark = pending_.size();
+        for (uint32_t i = 0; i < node.childCount; ++i) {
+            choices_.push_back(i);
+            const uint32_t c =
+                build(g_.child(n, i), Semantics::operand(s, i), mark, Affine::identity());
+            choices_.pop_back();
+            if (c == kNone) {
+                if (emptyOperandEmptiesAll(op, i)) return kNone;
+                continue;
+            }
+            kids.push_back(c);
+        }
+        if (kids.empty()) return kNone;
+        Box inside = out_.nodes_[kids[0]].box;
+        for (size_t k = 1; k < kids.size(); ++k) {
+            const Box& b = out_.nodes_[kids[k]].box;
+            if (op == CsgOp::Union) inside.extend(b);
+            if (op == CsgOp::Intersection) inside = intersect(inside, b);
+        }
+        Node x = emit(Kind::Operator, s.material, pendingBase, edge, inside);
+        x.op = op;
+        x.first = static_cast<uint32_t>(out_.children_.size());
+        x.count = static_cast<uint32_t>(kids.size());
+        out_.children_.insert(out_.children_.end(), kids.begin(), kids.end());
+        if (op != CsgOp::Union) setChoices(x);
+        out_.nodes_.push_back(x);
+        return static_cast<uint32_t>(out_.nodes_.size() - 1);
+    }
+
+    uint32_t buildPrimitive(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+        const PrimitiveKind kind = g_.primitives[g_.nodes[n].payload].kind;
+        if (kind == PrimitiveKind::Empty) return kNone;
+        double args[9] = {};
+        const uint32_t argc = sem_.primitiveArgs(n, s, args);
+        Node x = emit(isTriangle(kind) ? Kind::Triangle : Kind::Solid, s.material, pendingBase,
+                      edge, primitiveBox(kind, args));
+        x.prim = kind;
+        x.first = static_cast<uint32_t>(out_.args_.size());
+        x.count = argc;
+        out_.args_.insert(out_.args_.end(), args, args + argc);
+        setChoices(x);
+        out_.nodes_.push_back(x);
+        return static_cast<uint32_t>(out_.nodes_.size() - 1);
     }
 
     // A node entered through the matrices pending_[pendingBase..], holding `inside` (in
@@ -279,9 +257,9 @@ class ExpansionBuilder {
         out_.choices_.insert(out_.choices_.end(), choices_.begin(), choices_.end());
     }
 
-    const TraceScene& scene_;
+    const Semantics& sem_;
     const Graph& g_;
-    ExpandedInstance& out_;
+    UnrolledInstance& out_;
     const uint64_t maxVisits_;
     uint64_t visits_ = 0;
     uint32_t base_ = 0;
@@ -293,14 +271,14 @@ class ExpansionBuilder {
 // ---------------------------------------------------------------------------------------
 // Tracing: Tracer::first and Tracer::spans on the flat arrays.
 
-size_t ExpandedInstance::bytes() const {
+size_t UnrolledInstance::bytes() const {
     return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
            args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t) +
            bvh_.capacity() * sizeof(BvhNode) + items_.capacity() * sizeof(uint32_t);
 }
 
-LocalRay ExpandedInstance::enter(const Node& node, const LocalRay& r) const {
+LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
     LocalRay rr = r;
     for (uint32_t k = 0; k < node.matrices; ++k) {
         const Affine& m = matrices_[node.firstMatrix + k];
@@ -309,13 +287,13 @@ LocalRay ExpandedInstance::enter(const Node& node, const LocalRay& r) const {
     return rr;
 }
 
-Vec3 ExpandedInstance::leave(const Node& node, Vec3 normal) const {
+Vec3 UnrolledInstance::leave(const Node& node, Vec3 normal) const {
     for (uint32_t k = node.matrices; k-- > 0;)
         normal = matrices_[node.firstMatrix + k].transposedVector(normal);
     return normal;
 }
 
-uint64_t ExpandedInstance::keyOf(const Node& node, uint64_t path) const {
+uint64_t UnrolledInstance::keyOf(const Node& node, uint64_t path) const {
     for (uint32_t k = 0; k < node.choices; ++k) {
         const uint32_t c = choices_[node.firstChoice + k];
         path = (c & kRuleBit) ? pathRule(path, c & ~kRuleBit) : pathChild(path, c);
@@ -323,7 +301,7 @@ uint64_t ExpandedInstance::keyOf(const Node& node, uint64_t path) const {
     return path;
 }
 
-bool ExpandedInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
+bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
                              bool anyHit, Scratch& s) const {
     if (root_ == kNone) return false;
     double t0 = tmin, t1 = tmax;
@@ -331,7 +309,7 @@ bool ExpandedInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
     return firstAt(root_, r, tmin, tmax, hit, use, anyHit, s);
 }
 
-size_t ExpandedInstance::spans(const LocalRay& r, double tmin, double tmax,
+size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
                                std::vector<Span>& spans, const Use& use, Scratch& s) const {
     if (root_ == kNone) return 0;
     double t0 = tmin, t1 = tmax;
@@ -339,7 +317,7 @@ size_t ExpandedInstance::spans(const LocalRay& r, double tmin, double tmax,
     return spansAt(root_, r, tmin, tmax, spans, use, s);
 }
 
-bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit,
                                const Use& use, bool anyHit, Scratch& s) const {
     ++s.visits;
     const Node& node = nodes_[n];
@@ -404,7 +382,7 @@ bool ExpandedInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
 
 // The first hit among the nodes list[0..count), all entered from the same frame, as the
 // operands of a union.
-bool ExpandedInstance::firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r,
+bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r,
                                     double tmin, double& tmax, Hit& hit, const Use& use,
                                     bool anyHit, Scratch& s) const {
     return firstOfUnion(
@@ -418,7 +396,7 @@ bool ExpandedInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         });
 }
 
-bool ExpandedInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+bool UnrolledInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
                                 const Use& use, bool anyHit, Scratch& s) const {
     const BvhNode& bn = bvh_[b];
     if (bn.left == kNone)
@@ -435,7 +413,7 @@ bool ExpandedInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, doub
         });
 }
 
-size_t ExpandedInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
+size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
                                  std::vector<Span>& spans, const Use& use, Scratch& s) const {
     ++s.visits;
     const Node& node = nodes_[n];
@@ -477,15 +455,15 @@ size_t ExpandedInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
 
 // ---------------------------------------------------------------------------------------
 
-ExpansionCache::ExpansionCache(const TraceScene& scene, size_t maxBytes)
+UnrollCache::UnrollCache(const TraceScene& scene, size_t maxBytes)
     : scene_(scene),
       maxBytes_(maxBytes),
       yield_(scene.graph().modules.size() * (scene.graph().scene.settings.maxDepth + 2)),
       levels_(scene.graph().scene.settings.maxDepth + 2) {}
 
-ExpansionCache::~ExpansionCache() = default;
+UnrollCache::~UnrollCache() = default;
 
-void ExpansionCache::evict() {
+void UnrollCache::evict() {
     while (bytes_ > maxBytes_ && lru_.size() > 1) {
         const Entry& last = lru_.back();
         bytes_ -= last.bytes;
@@ -494,8 +472,8 @@ void ExpansionCache::evict() {
     }
 }
 
-const ExpandedInstance* ExpansionCache::get(NodeId select, uint32_t depth, const double* frame,
-                                            uint64_t path) {
+const UnrolledInstance* UnrollCache::get(NodeId select, uint32_t depth, const double* frame,
+                                         uint64_t path) {
     if (depth >= levels_) return nullptr;
     Yield& y = yield_[static_cast<size_t>(scene_.graph().nodes[select].payload) * levels_ + depth];
     if (y.off) return nullptr;
@@ -525,8 +503,8 @@ const ExpandedInstance* ExpansionCache::get(NodeId select, uint32_t depth, const
         return nullptr;
     }
     // The second meeting: expand.
-    auto x = std::make_unique<ExpandedInstance>();
-    ExpansionBuilder builder(scene_, *x, 4 * boxes->maxExpandWeight());
+    auto x = std::make_unique<UnrolledInstance>();
+    Unroller builder(scene_, *x, 4 * boxes->maxUnrollWeight());
     try {
         builder.run(select, depth, frame, path);
     } catch (const TooLarge&) {
@@ -540,7 +518,7 @@ const ExpandedInstance* ExpansionCache::get(NodeId select, uint32_t depth, const
     bytes_ += b - e.bytes;
     e.bytes = b;
     e.instance = std::move(x);
-    const ExpandedInstance* result = e.instance.get();
+    const UnrolledInstance* result = e.instance.get();
     evict();
     return result;
 }

@@ -1,0 +1,89 @@
+// Entering a node of the cyclic graph: see semantics.h.
+#include "semantics.h"
+
+#include "primitive_table.h"
+
+namespace pcsg {
+
+Semantics::Semantics(const Graph& g) : g_(g), fused_(g.nodes.size()) {
+    const size_t n = g.nodes.size();
+    auto constantT = [&](NodeId m) {
+        return g.nodes[m].kind == NodeKind::Transform && g.transforms[g.nodes[m].payload].constant;
+    };
+    for (NodeId m = 0; m < n; ++m) {
+        if (!constantT(m)) continue;
+        // The chain of constant T-nodes below m: M_m M_c1 ... M_ck, and its inverse
+        // M_ck^-1 ... M_c1^-1 M_m^-1.
+        Fused& f = fused_[m];
+        f.forward = g.transforms[g.nodes[m].payload].matrix;
+        f.inverse = f.forward.inverse();
+        f.forward = Affine::identity() * f.forward;
+        NodeId c = g.child(m);
+        for (size_t guard = 0; constantT(c) && guard < n; ++guard) {
+            const Affine& mc = g.transforms[g.nodes[c].payload].matrix;
+            f.forward = f.forward * mc;
+            f.inverse = mc.inverse() * f.inverse;
+            c = g.child(c);
+        }
+        f.target = c;
+    }
+}
+
+Step Semantics::enter(NodeId n, const PathState& s, StepScratch& scratch) const {
+    const Node& node = g_.nodes[n];
+    Step step;
+    step.state = s;
+    switch (node.kind) {
+        case NodeKind::Select: {
+            step.state.depth = selectDepth(n, s);
+            step.rule = selectRule(g_, n, EvalState{s.frame, s.path});
+            step.state.path = pathRule(s.path, step.rule);
+            step.child = g_.child(n, step.rule);
+            return step;
+        }
+        case NodeKind::Calc:
+            applyCalc(g_, n, EvalState{s.frame, s.path}, scratch.frame);
+            step.state.frame = scratch.frame;
+            step.child = g_.child(n);
+            return step;
+        case NodeKind::Transform: {
+            const Fused& f = fused_[n];
+            if (f.target != kNone) {
+                step.child = f.target;
+                step.forward = &f.forward;
+                step.inverse = &f.inverse;
+                return step;
+            }
+            scratch.forward = transformMatrix(g_, n, EvalState{s.frame, s.path});
+            scratch.inverse = scratch.forward.inverse();
+            step.child = g_.child(n);
+            step.forward = &scratch.forward;
+            step.inverse = &scratch.inverse;
+            return step;
+        }
+        case NodeKind::Paint:
+            step.state.material = node.payload;
+            step.child = g_.child(n);
+            return step;
+        case NodeKind::Operator:
+        case NodeKind::Primitive:
+            break;  // not unary: operand() and primitiveArgs()
+    }
+    return step;
+}
+
+Affine Semantics::forwardThrough(const Affine& outer, NodeId n, const Step& st) const {
+    if (fused_[n].target == kNone) return outer * *st.forward;
+    Affine m = outer;
+    for (NodeId k = n; k != st.child; k = g_.child(k))
+        m = m * g_.transforms[g_.nodes[k].payload].matrix;
+    return m;
+}
+
+uint32_t Semantics::primitiveArgs(NodeId n, const PathState& s, double* out) const {
+    const uint32_t count = primitiveArgCount(g_.primitives[g_.nodes[n].payload].kind);
+    if (count) pcsg::primitiveArgs(g_, n, EvalState{s.frame, s.path}, out);
+    return count;
+}
+
+}  // namespace pcsg

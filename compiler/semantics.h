@@ -1,0 +1,103 @@
+// What it means to enter a node of the cyclic graph: the one step that every walker takes,
+// whatever it walks for (docs/language.md sections 3 to 6).
+//
+// A walker carries a PathState down the graph: the parameter frame, the instance path, the
+// S-node depth and the innermost material. Entering a node gives the node to go on to and
+// the state there:
+//
+//  - an S-node checks max_depth, selects its rule (the instance path records which) and
+//    leads to the rule's body one level deeper;
+//  - a C-node computes a new frame (into storage the walker provides) for its operand;
+//  - a T-node leads to its operand through its matrix; a chain of T-nodes whose arguments
+//    are all constants counts as one step with the chain's product and its inverse,
+//    computed once here;
+//  - a paint node sets the material;
+//  - an operator's operand i gets the instance path extended by i (operand());
+//  - a primitive's arguments come from primitiveArgs().
+//
+// The walkers decide only how to recurse: the explicit-stack walk of compiler/walk.h (the
+// exporter's expansion and the tracer's instance boxes), the tracer's recursion with a ray
+// (tracer/traversal.cpp) and the tracer's unrolled instances (tracer/unrolled_instances.cpp).
+// Because all of them take this step, an unrolled instance meets the same matrices, frames
+// and paths as the walk, and hits the same surfaces bit for bit.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "eval.h"
+#include "graph.h"
+
+namespace pcsg {
+
+struct PathState {
+    const double* frame = nullptr;  // Graph::slotCount() values
+    uint64_t path = kRootPath;      // the instance path (docs/language.md section 6)
+    uint32_t depth = 0;             // S-nodes passed on the way here
+    uint32_t material = 0;          // the innermost paint so far (0: the default)
+};
+
+// Where entering a unary node (S, C, T, paint) leads.
+struct Step {
+    NodeId child = kNone;             // the node to go on to
+    PathState state;                  // the state there
+    uint32_t rule = kNone;            // S-nodes: the rule taken (0-based)
+    const Affine* forward = nullptr;  // T-nodes: maps `child`'s frame into this node's
+    const Affine* inverse = nullptr;  // T-nodes: the inverse of `forward`
+};
+
+// Storage a walker lends to enter(): the new frame of a C-node (Graph::slotCount() values,
+// not the incoming frame) and the matrices of a T-node that depends on parameters.
+struct StepScratch {
+    double* frame = nullptr;
+    Affine forward, inverse;
+};
+
+class Semantics {
+  public:
+    explicit Semantics(const Graph& g);
+
+    const Graph& graph() const { return g_; }
+
+    // The depth an S-node instance has when entered from state s; throws the max_depth
+    // RuntimeError when it is beyond settings max_depth. Walkers that cull before they
+    // select call this first, so that culling can never hide the error.
+    uint32_t selectDepth(NodeId select, const PathState& s) const {
+        checkDepth(g_, select, s.depth + 1, EvalState{s.frame, s.path});
+        return s.depth + 1;
+    }
+
+    // Enters the unary node n from state s. Throws RuntimeError (without module path: the
+    // walker adds it as the error passes its S-nodes).
+    Step enter(NodeId n, const PathState& s, StepScratch& scratch) const;
+
+    // outer * (the matrix of the T-step `st` taken at n), multiplied T-node by T-node along a
+    // fused chain, so that a world matrix is the same product whether or not the chain's
+    // T-nodes were folded into constants.
+    Affine forwardThrough(const Affine& outer, NodeId n, const Step& st) const;
+
+    // The state of operand i of an operator.
+    static PathState operand(const PathState& s, uint32_t i) {
+        return PathState{s.frame, pathChild(s.path, i), s.depth, s.material};
+    }
+
+    // A primitive's argument values in state s, into out[0..8]; returns their number
+    // (torus 2, triangle 9, tri1/tri2 and the solids without arguments 0).
+    uint32_t primitiveArgs(NodeId n, const PathState& s, double* out) const;
+
+    // Constant T-node chains: where the chain starting at T-node n leads (kNone when n is
+    // not a constant T-node), and its product and inverse.
+    NodeId fusedTarget(NodeId n) const { return fused_[n].target; }
+    const Affine& fusedForward(NodeId n) const { return fused_[n].forward; }
+    const Affine& fusedInverse(NodeId n) const { return fused_[n].inverse; }
+
+  private:
+    struct Fused {
+        NodeId target = kNone;
+        Affine forward, inverse;
+    };
+    const Graph& g_;
+    std::vector<Fused> fused_;  // per node
+};
+
+}  // namespace pcsg
