@@ -38,8 +38,12 @@ inline std::optional<ImageFormat> imageFormatOf(const std::string& path) {
 inline std::filesystem::path temporaryBeside(const std::filesystem::path& target) {
     const std::filesystem::path dir =
         target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-    return dir / (("." + target.stem().string() + ".tmp") + std::to_string(getpid()) +
-                  target.extension().string());
+    std::string name(1, '.');
+    name.append(target.stem().string())
+        .append(".tmp")
+        .append(std::to_string(getpid()))
+        .append(target.extension().string());
+    return dir / name;
 }
 
 // For error messages about an unknown type.
