@@ -1,0 +1,59 @@
+// The in-process PNG writer of `pcsg render`: 8-bit sRGB values rounded as every 8-bit
+// image of pcsg is, read back by OpenImageIO as they were written, and a failure that
+// names the file and leaves nothing behind.
+#include "png_writer.h"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cli_test_util.h"
+#include "image_test_util.h"
+
+namespace pcsg::tools {
+namespace {
+
+using testing::filesIn;
+using testing::readBack;
+using testing::TempDir;
+
+// Black, white, mid-grey, clamping above 1 and below 0, and the linear segment near 0,
+// with their 8-bit sRGB values worked out independently (see pcsg_image_test.cpp).
+const std::vector<float> kPixels = {0.0f, 0.5f, 1.0f, 0.2f, 2.0f, -1.0f, 0.001f, 0.05f, 0.5f};
+const std::vector<uint8_t> k8Bit = {0, 188, 255, 124, 255, 0, 3, 63, 188};
+
+TEST(PngWriter, EncodesEightBitSrgb) {
+    EXPECT_EQ(srgbBytes(kPixels), k8Bit);
+}
+
+TEST(PngWriter, OpenImageIOReadsBackWhatWasWritten) {
+    TempDir dir;
+    const std::string out = dir.file("img.png");
+    writePng(out, 3, 1, kPixels);
+    OIIO::ImageSpec spec;
+    const auto px = readBack<uint8_t>(out, OIIO::TypeDesc::UINT8, spec);
+    EXPECT_EQ(spec.width, 3);
+    EXPECT_EQ(spec.height, 1);
+    EXPECT_EQ(spec.nchannels, 3);
+    EXPECT_EQ(px, k8Bit);
+    EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"img.png"});
+}
+
+TEST(PngWriter, AFailureNamesTheFileAndLeavesNothing) {
+    TempDir dir;
+    const std::string out = dir.file("no/such/dir/img.png");
+    try {
+        writePng(out, 3, 1, kPixels);
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("cannot write '" + out + "': ", 0), 0u) << e.what();
+    }
+    EXPECT_THROW(writePng(dir.file("img.png"), 2, 1, kPixels), std::runtime_error);  // sizes
+    EXPECT_TRUE(filesIn(dir.path()).empty());
+}
+
+}  // namespace
+}  // namespace pcsg::tools
