@@ -81,7 +81,7 @@ void checkTriangles(BuildContext& ctx) {
                 fmt::format("a triangle ({} at line {}) is reachable as an operand of this {}: "
                             "triangles are surfaces without an inside, so only '∪' may "
                             "combine them",
-                            triangleName(g.primitives[tri.payload].kind), tri.loc.line,
+                            primitiveName(g.primitives[tri.payload].kind), tri.loc.line,
                             csgOpName(n.op())));
             break;
         }

@@ -5,8 +5,8 @@
 //  - Names: what build_names.cpp resolves from the whole file (modules and their rules,
 //    definitions and the order to build them in, materials, assigned parameters, the
 //    axiom), read by the later phases.
-//  - The builder's per-primitive facts, in one place until compiler/primitive_table.h
-//    takes them over.
+//  - The one per-primitive fact that compiler/primitive_table.h does not hold: the
+//    names of the arguments, for messages.
 //
 // Phase-local state (the S-node of each definition, the directives seen once, the
 // expression code generator's mode) stays in the phase that owns it.
@@ -23,6 +23,7 @@
 #include "diagnostics.h"
 #include "graph.h"
 #include "lexer.h"
+#include "primitive_table.h"
 
 namespace pcsg {
 
@@ -74,21 +75,10 @@ struct Names {
 
 std::string argumentCount(uint32_t n);  // "1 argument", "3 arguments"
 
-// --- the builder's per-primitive facts (compiler/primitive_table.h will hold them) ---
-
-// The arguments a primitive takes, and their names for messages.
-inline uint32_t primitiveArgCount(PrimitiveKind k) {
-    return k == PrimitiveKind::Torus ? 2 : k == PrimitiveKind::Triangle ? 9 : 0;
-}
+// The argument names of a primitive that takes arguments, for messages (the counts are
+// in primitive_table.h).
 inline const char* primitiveArgNames(PrimitiveKind k) {
     return k == PrimitiveKind::Torus ? "R, r" : "x1, y1, z1, x2, y2, z2, x3, y3, z3";
-}
-// Triangles are surfaces without an inside (section 5).
-inline bool isTriangle(PrimitiveKind k) {
-    return k == PrimitiveKind::Tri1 || k == PrimitiveKind::Tri2 || k == PrimitiveKind::Triangle;
-}
-inline const char* triangleName(PrimitiveKind k) {
-    return k == PrimitiveKind::Tri1 ? "tri1" : k == PrimitiveKind::Tri2 ? "tri2" : "triangle";
 }
 
 }  // namespace pcsg
