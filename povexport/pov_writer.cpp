@@ -366,56 +366,72 @@ class TreeWriter {
 
     void step() {
         Item& it = stack_.back();
-        if (!it.group) {
-            const TreeNode& node = t_.nodes[it.node];
-            if (node.primitive) {
-                if (putPrimitive(o_, t_, t_.primitiveOf(it.node), indent()))
-                    ++stats_.objects;
-                else
-                    ++stats_.skipped;
-                stack_.pop_back();
-                return;
-            }
-            const bool deep = stack_.size() > kMaxNesting;
-            if (node.is(CsgOp::Union) && it.next == 0 && (node.count > maxChildren_ || deep)) {
-                // Regroup: the operands become a group item over a run of `members`. Deep
-                // in the tree (a long chain of unions from a linear recursion), the
-                // union's whole union-subtree is flattened first: POV-Ray's parser
-                // crashes at about 19,000 nested braces.
-                const uint32_t n = it.node;
-                const size_t lo = members_.size();
-                if (deep)
-                    flattenUnion(n);
-                else
-                    members_.insert(members_.end(), t_.childrenOf(n),
-                                    t_.childrenOf(n) + node.count);
-                stack_.pop_back();
-                Item g;
-                g.group = true;
-                g.lo = lo;
-                g.hi = members_.size();
-                g.ownsMembers = true;
-                stack_.push_back(std::move(g));
-                return;
-            }
-            if (it.next == 0) {
-                o_.put("{}{} {{\n", indent(), csgOpName(node.op));
-            }
-            if (it.next < node.count) {
-                const uint32_t c = t_.childrenOf(it.node)[it.next++];
-                stack_.push_back(nodeItem(c));
-                return;
-            }
-            const Box& b = boxes_[it.node];
-            const bool bound = !node.is(CsgOp::Union) || opt_.boundUnions;
-            o_.put("{}", indent());
-            if (bound && boundable(b)) putBound(o_, b);
-            o_.put(" }}\n");
-            stack_.pop_back();
+        if (it.group)
+            stepGroup(it);
+        else
+            stepNode(it);
+    }
+
+    // One step on a tree node: a primitive's line, the regrouping of a big union, an
+    // operation's opening line, its next child, or its closing bound.
+    void stepNode(Item& it) {
+        const TreeNode& node = t_.nodes[it.node];
+        if (node.primitive) {
+            writePrimitive(it.node);
             return;
         }
+        const bool deep = stack_.size() > kMaxNesting;
+        if (node.is(CsgOp::Union) && it.next == 0 && (node.count > maxChildren_ || deep)) {
+            regroupUnion(it.node, deep);
+            return;
+        }
+        if (it.next == 0) {
+            o_.put("{}{} {{\n", indent(), csgOpName(node.op));
+        }
+        if (it.next < node.count) {
+            const uint32_t c = t_.childrenOf(it.node)[it.next++];
+            stack_.push_back(nodeItem(c));
+            return;
+        }
+        const Box& b = boxes_[it.node];
+        const bool bound = !node.is(CsgOp::Union) || opt_.boundUnions;
+        o_.put("{}", indent());
+        if (bound && boundable(b)) putBound(o_, b);
+        o_.put(" }}\n");
+        stack_.pop_back();
+    }
 
-        // A group of members[lo, hi).
+    // Writes the primitive of the top item, node n, and pops it.
+    void writePrimitive(uint32_t n) {
+        if (putPrimitive(o_, t_, t_.primitiveOf(n), indent()))
+            ++stats_.objects;
+        else
+            ++stats_.skipped;
+        stack_.pop_back();
+    }
+
+    // Replaces the top item, union n, by a group item over a run of `members` holding its
+    // operands. Deep in the tree (a long chain of unions from a linear recursion), the
+    // union's whole union-subtree is flattened first: POV-Ray's parser crashes at about
+    // 19,000 nested braces.
+    void regroupUnion(uint32_t n, bool deep) {
+        const size_t lo = members_.size();
+        if (deep)
+            flattenUnion(n);
+        else
+            members_.insert(members_.end(), t_.childrenOf(n), t_.childrenOf(n) + t_.nodes[n].count);
+        stack_.pop_back();
+        Item g;
+        g.group = true;
+        g.lo = lo;
+        g.hi = members_.size();
+        g.ownsMembers = true;
+        stack_.push_back(std::move(g));
+    }
+
+    // One step on a group of members[lo, hi): its opening line (or, for a single member,
+    // the member itself), its next member or sub-group, or its closing bound.
+    void stepGroup(Item& it) {
         const size_t n = it.hi - it.lo;
         if (it.next == 0) {
             if (n == 1) {

@@ -286,6 +286,26 @@ Interval callFunc(Func f, const Interval* a, uint32_t n, uint64_t seed) {
     return Interval::all();
 }
 
+// An arithmetic or comparison operator of the expression code.
+Interval binaryOp(Op op, const Interval& a, const Interval& b) {
+    switch (op) {
+        case Op::Add:
+            return add(a, b);
+        case Op::Sub:
+            return sub(a, b);
+        case Op::Mul:
+            return mul(a, b);
+        case Op::Div:
+            return div(a, b);
+        case Op::Mod:
+            return fmodInterval(a, b);
+        case Op::Pow:
+            return powInterval(a, b);
+        default:
+            return compare(op, a, b);
+    }
+}
+
 // The interpreter: `if` and the short-circuit operators compile to jumps; when a
 // condition may be both zero and non-zero both continuations run and their results are
 // joined. `forks` bounds the work (beyond it, the result is everything). With `leaves`
@@ -309,70 +329,6 @@ struct IntervalVm {
         while (pc < end) {
             const Instr& in = code[pc++];
             switch (in.op) {
-                case Op::Const:
-                    stack.push_back(Interval::point(in.imm));
-                    break;
-                case Op::Load: {
-                    const AbstractSlot& s = frame[in.a];
-                    if (s.value.isBottom()) return Interval::bottom();  // always unassigned
-                    stack.push_back(s.value);
-                    break;
-                }
-                case Op::Neg:
-                    stack.back() = neg(stack.back());
-                    break;
-                case Op::Not: {
-                    const Interval v = stack.back();
-                    stack.back() = boolean(v.contains(0), v.nan || hasNonZero(v));
-                    break;
-                }
-                case Op::ToBool: {
-                    const Interval v = stack.back();
-                    stack.back() = boolean(v.nan || hasNonZero(v), v.contains(0));
-                    break;
-                }
-                case Op::Add:
-                case Op::Sub:
-                case Op::Mul:
-                case Op::Div:
-                case Op::Mod:
-                case Op::Pow:
-                case Op::Lt:
-                case Op::Le:
-                case Op::Gt:
-                case Op::Ge:
-                case Op::Eq:
-                case Op::Ne: {
-                    const Interval b = stack.back();
-                    stack.pop_back();
-                    const Interval a = stack.back();
-                    Interval r;
-                    switch (in.op) {
-                        case Op::Add:
-                            r = add(a, b);
-                            break;
-                        case Op::Sub:
-                            r = sub(a, b);
-                            break;
-                        case Op::Mul:
-                            r = mul(a, b);
-                            break;
-                        case Op::Div:
-                            r = div(a, b);
-                            break;
-                        case Op::Mod:
-                            r = fmodInterval(a, b);
-                            break;
-                        case Op::Pow:
-                            r = powInterval(a, b);
-                            break;
-                        default:
-                            r = compare(in.op, a, b);
-                            break;
-                    }
-                    stack.back() = r;
-                    break;
-                }
                 case Op::Jump:
                     pc = in.a;
                     break;
@@ -393,27 +349,81 @@ struct IntervalVm {
                         return Interval::bottom();
                     break;
                 }
-                case Op::Call: {
-                    const size_t base = stack.size() - in.argc;
-                    const Interval r =
-                        callFunc(static_cast<Func>(in.a), stack.data() + base, in.argc, seed);
-                    stack.resize(base);
-                    stack.push_back(r);
+                default:
+                    if (!execute(in, stack)) return Interval::bottom();
                     break;
-                }
-                case Op::Rand0:
-                    stack.push_back(reals(0, 1));
-                    break;
-                case Op::Choose: {
-                    const size_t base = stack.size() - in.argc;
-                    stack.resize(base);
-                    stack.push_back(reals(1, in.argc));
-                    break;
-                }
             }
             if (!stack.empty() && stack.back().isBottom()) return Interval::bottom();
         }
         return leaf(stack.empty() ? Interval::all() : stack.back());
+    }
+
+    // Runs one instruction that does not jump, on the stack; false when it reads a slot
+    // that is never assigned (every evaluation fails).
+    bool execute(const Instr& in, std::vector<Interval>& stack) const {
+        switch (in.op) {
+            case Op::Const:
+                stack.push_back(Interval::point(in.imm));
+                break;
+            case Op::Load: {
+                const AbstractSlot& s = frame[in.a];
+                if (s.value.isBottom()) return false;  // always unassigned
+                stack.push_back(s.value);
+                break;
+            }
+            case Op::Neg:
+                stack.back() = neg(stack.back());
+                break;
+            case Op::Not: {
+                const Interval v = stack.back();
+                stack.back() = boolean(v.contains(0), v.nan || hasNonZero(v));
+                break;
+            }
+            case Op::ToBool: {
+                const Interval v = stack.back();
+                stack.back() = boolean(v.nan || hasNonZero(v), v.contains(0));
+                break;
+            }
+            case Op::Add:
+            case Op::Sub:
+            case Op::Mul:
+            case Op::Div:
+            case Op::Mod:
+            case Op::Pow:
+            case Op::Lt:
+            case Op::Le:
+            case Op::Gt:
+            case Op::Ge:
+            case Op::Eq:
+            case Op::Ne: {
+                const Interval b = stack.back();
+                stack.pop_back();
+                const Interval a = stack.back();
+                stack.back() = binaryOp(in.op, a, b);
+                break;
+            }
+            case Op::Call: {
+                const size_t base = stack.size() - in.argc;
+                const Interval r =
+                    callFunc(static_cast<Func>(in.a), stack.data() + base, in.argc, seed);
+                stack.resize(base);
+                stack.push_back(r);
+                break;
+            }
+            case Op::Rand0:
+                stack.push_back(reals(0, 1));
+                break;
+            case Op::Choose: {
+                const size_t base = stack.size() - in.argc;
+                stack.resize(base);
+                stack.push_back(reals(1, in.argc));
+                break;
+            }
+            case Op::Jump:
+            case Op::JumpIfZero:
+                break;  // run's
+        }
+        return true;
     }
 };
 
@@ -421,6 +431,91 @@ struct IntervalVm {
 // in transformations and primitive arguments).
 Interval finiteArg(const Interval& a) {
     return Interval{a.lo, a.hi, false};
+}
+
+// RotX, RotY or RotZ by an angle in the interval: sets the rotation's plane in `out`.
+void planeRotationInterval(TransformOp op, const Interval& angle, IntervalAffine& out) {
+    auto& l = out.l;
+    const Interval c = cosInterval(angle), s = sinInterval(angle);
+    const Interval ns = neg(s);
+    const int p = op == TransformOp::RotX ? 1 : (op == TransformOp::RotY ? 2 : 0);
+    const int q = (p + 1) % 3;
+    // rotation in the (p, q) plane: RotX (y,z), RotY (z,x), RotZ (x,y)
+    l[p][p] = c, l[p][q] = ns, l[q][p] = s, l[q][q] = c;
+}
+
+// Rot: by the angle a[3] about the axis (a[0], a[1], a[2]), into `out`'s linear part;
+// false when the axis is the zero vector (every evaluation fails).
+bool axisRotationInterval(const Interval* a, IntervalAffine& out) {
+    auto& l = out.l;
+    const Interval one = Interval::of(-1, 1);
+    if (!(a[0].isPoint() && a[1].isPoint() && a[2].isPoint())) {
+        for (auto& row : l)
+            for (auto& e : row) e = one;
+        return true;
+    }
+    const double len = std::sqrt(a[0].lo * a[0].lo + a[1].lo * a[1].lo + a[2].lo * a[2].lo);
+    if (!(len > 0)) return false;
+    const double k[3] = {a[0].lo / len, a[1].lo / len, a[2].lo / len};
+    const Interval c = cosInterval(a[3]), s = sinInterval(a[3]);
+    const Interval tt = sub(Interval::point(1), c);
+    auto kk = [&](int i, int j) { return mul(tt, Interval::point(k[i] * k[j])); };
+    auto sk = [&](int i) { return mul(s, Interval::point(k[i])); };
+    l[0][0] = add(c, kk(0, 0));
+    l[0][1] = sub(kk(0, 1), sk(2));
+    l[0][2] = add(kk(0, 2), sk(1));
+    l[1][0] = add(kk(1, 0), sk(2));
+    l[1][1] = add(c, kk(1, 1));
+    l[1][2] = sub(kk(1, 2), sk(0));
+    l[2][0] = sub(kk(2, 0), sk(1));
+    l[2][1] = add(kk(2, 1), sk(0));
+    l[2][2] = add(c, kk(2, 2));
+    for (auto& row : l)
+        for (auto& e : row) e = Interval{std::max(e.lo, -1.0), std::min(e.hi, 1.0), false};
+    return true;
+}
+
+// The matrices of a transformation whose arguments (finite, not all points) are in `a`;
+// false when every evaluation fails.
+bool transformOfIntervals(TransformOp op, const Interval* a, IntervalAffine& out) {
+    out = IntervalAffine::of(Affine::identity());
+    auto& l = out.l;
+    switch (op) {
+        case TransformOp::Move:
+            out.t[0] = a[0], out.t[1] = a[1], out.t[2] = a[2];
+            break;
+        case TransformOp::Scale:
+            l[0][0] = a[0], l[1][1] = a[1], l[2][2] = a[2];
+            break;
+        case TransformOp::UScale:
+            l[0][0] = l[1][1] = l[2][2] = a[0];
+            break;
+        case TransformOp::RotX:
+        case TransformOp::RotY:
+        case TransformOp::RotZ:
+            planeRotationInterval(op, a[0], out);
+            break;
+        case TransformOp::Rot:
+            return axisRotationInterval(a, out);
+        case TransformOp::ZShear:
+            l[2][0] = a[0], l[2][1] = a[1];
+            break;
+        case TransformOp::FlipYZ:
+            l[0][0] = Interval::point(-1);
+            break;
+        case TransformOp::FlipXZ:
+            l[1][1] = Interval::point(-1);
+            break;
+        case TransformOp::FlipXY:
+            l[2][2] = Interval::point(-1);
+            break;
+        case TransformOp::Matrix:
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) l[i][j] = a[3 * j + i];
+            out.t[0] = a[9], out.t[1] = a[10], out.t[2] = a[11];
+            break;
+    }
+    return true;
 }
 
 }  // namespace
@@ -458,17 +553,6 @@ AbstractFrame widen(const AbstractFrame& prev, const AbstractFrame& next) {
         if (out[i].value.hi > prev[i].value.hi) out[i].value.hi = kInf;
     }
     return out;
-}
-
-double sinDegrees(double a) {
-    const double r = std::fmod(a, 360.0);
-    if (r == 0 || r == 180 || r == -180) return 0;
-    if (r == 90 || r == -270) return 1;
-    if (r == -90 || r == 270) return -1;
-    return std::sin(a * kDegToRad);
-}
-double cosDegrees(double a) {
-    return sinDegrees(a + 90.0);
 }
 
 Interval evalInterval(const Graph& g, ExprId e, const AbstractFrame& frame) {
@@ -581,75 +665,7 @@ bool transformInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Int
         out = IntervalAffine::of(makeTransform(t.op, v));
         return true;
     }
-    out = IntervalAffine::of(Affine::identity());
-    auto& l = out.l;
-    switch (t.op) {
-        case TransformOp::Move:
-            out.t[0] = a[0], out.t[1] = a[1], out.t[2] = a[2];
-            break;
-        case TransformOp::Scale:
-            l[0][0] = a[0], l[1][1] = a[1], l[2][2] = a[2];
-            break;
-        case TransformOp::UScale:
-            l[0][0] = l[1][1] = l[2][2] = a[0];
-            break;
-        case TransformOp::RotX:
-        case TransformOp::RotY:
-        case TransformOp::RotZ: {
-            const Interval c = cosInterval(a[0]), s = sinInterval(a[0]);
-            const Interval ns = neg(s);
-            const int p = t.op == TransformOp::RotX ? 1 : (t.op == TransformOp::RotY ? 2 : 0);
-            const int q = (p + 1) % 3;
-            // rotation in the (p, q) plane: RotX (y,z), RotY (z,x), RotZ (x,y)
-            l[p][p] = c, l[p][q] = ns, l[q][p] = s, l[q][q] = c;
-            break;
-        }
-        case TransformOp::Rot: {
-            const Interval one = Interval::of(-1, 1);
-            if (!(a[0].isPoint() && a[1].isPoint() && a[2].isPoint())) {
-                for (auto& row : l)
-                    for (auto& e : row) e = one;
-                break;
-            }
-            const double len = std::sqrt(a[0].lo * a[0].lo + a[1].lo * a[1].lo + a[2].lo * a[2].lo);
-            if (!(len > 0)) return false;
-            const double k[3] = {a[0].lo / len, a[1].lo / len, a[2].lo / len};
-            const Interval c = cosInterval(a[3]), s = sinInterval(a[3]);
-            const Interval tt = sub(Interval::point(1), c);
-            auto kk = [&](int i, int j) { return mul(tt, Interval::point(k[i] * k[j])); };
-            auto sk = [&](int i) { return mul(s, Interval::point(k[i])); };
-            l[0][0] = add(c, kk(0, 0));
-            l[0][1] = sub(kk(0, 1), sk(2));
-            l[0][2] = add(kk(0, 2), sk(1));
-            l[1][0] = add(kk(1, 0), sk(2));
-            l[1][1] = add(c, kk(1, 1));
-            l[1][2] = sub(kk(1, 2), sk(0));
-            l[2][0] = sub(kk(2, 0), sk(1));
-            l[2][1] = add(kk(2, 1), sk(0));
-            l[2][2] = add(c, kk(2, 2));
-            for (auto& row : l)
-                for (auto& e : row) e = Interval{std::max(e.lo, -1.0), std::min(e.hi, 1.0), false};
-            break;
-        }
-        case TransformOp::ZShear:
-            l[2][0] = a[0], l[2][1] = a[1];
-            break;
-        case TransformOp::FlipYZ:
-            l[0][0] = Interval::point(-1);
-            break;
-        case TransformOp::FlipXZ:
-            l[1][1] = Interval::point(-1);
-            break;
-        case TransformOp::FlipXY:
-            l[2][2] = Interval::point(-1);
-            break;
-        case TransformOp::Matrix:
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) l[i][j] = a[3 * j + i];
-            out.t[0] = a[9], out.t[1] = a[10], out.t[2] = a[11];
-            break;
-    }
-    return true;
+    return transformOfIntervals(t.op, a, out);
 }
 
 bool primitiveArgsInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Interval* out) {

@@ -93,8 +93,4 @@ bool primitiveArgsInterval(const Graph& g, NodeId primitiveNode, const AbstractF
 
 Box transformBox(const IntervalAffine& m, const Box& b);
 
-// sin and cos of degrees, as eval.cpp computes them (exact at multiples of 90).
-double sinDegrees(double a);
-double cosDegrees(double a);
-
 }  // namespace pcsg::tracer
