@@ -99,19 +99,6 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
-// sin and cos of an angle in degrees, exact at multiples of 90 so that rotz(90) maps +x
-// exactly to +y.
-double sinDeg(double a) {
-    const double r = std::fmod(a, 360.0);
-    if (r == 0 || r == 180 || r == -180) return 0;
-    if (r == 90 || r == -270) return 1;
-    if (r == -90 || r == 270) return -1;
-    return std::sin(a * kDegToRad);
-}
-double cosDeg(double a) {
-    return sinDeg(a + 90.0);
-}
-
 [[noreturn]] void unassignedRead(const Graph& g, const Expr& e, Slot s) {
     throw RuntimeError(e.loc, fmt::format("parameter '{}' is read before it is assigned on "
                                           "this path (in '{}')",
@@ -121,11 +108,11 @@ double cosDeg(double a) {
 double callFunc(Func f, const double* a, uint32_t n, uint64_t seed) {
     switch (f) {
         case Func::Sin:
-            return sinDeg(a[0]);
+            return sinDegrees(a[0]);
         case Func::Cos:
-            return cosDeg(a[0]);
+            return cosDegrees(a[0]);
         case Func::Tan:
-            return sinDeg(a[0]) / cosDeg(a[0]);
+            return sinDegrees(a[0]) / cosDegrees(a[0]);
         case Func::Asin:
             return std::asin(a[0]) / kDegToRad;
         case Func::Acos:
@@ -350,17 +337,17 @@ Affine makeTransform(TransformOp op, const double* a) {
         case TransformOp::UScale:
             return Affine::scale({a[0], a[0], a[0]});
         case TransformOp::RotX: {
-            const double c = cosDeg(a[0]), s = sinDeg(a[0]);
+            const double c = cosDegrees(a[0]), s = sinDegrees(a[0]);
             m.l[1][1] = c, m.l[1][2] = -s, m.l[2][1] = s, m.l[2][2] = c;
             return m;
         }
         case TransformOp::RotY: {
-            const double c = cosDeg(a[0]), s = sinDeg(a[0]);
+            const double c = cosDegrees(a[0]), s = sinDegrees(a[0]);
             m.l[0][0] = c, m.l[0][2] = s, m.l[2][0] = -s, m.l[2][2] = c;
             return m;
         }
         case TransformOp::RotZ: {
-            const double c = cosDeg(a[0]), s = sinDeg(a[0]);
+            const double c = cosDegrees(a[0]), s = sinDegrees(a[0]);
             m.l[0][0] = c, m.l[0][1] = -s, m.l[1][0] = s, m.l[1][1] = c;
             return m;
         }
@@ -368,7 +355,7 @@ Affine makeTransform(TransformOp op, const double* a) {
             // Rodrigues' formula about the unit axis k: R = cI + s[k]x + (1-c) k k^T.
             const double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
             const Vec3 k{a[0] / len, a[1] / len, a[2] / len};
-            const double c = cosDeg(a[3]), s = sinDeg(a[3]), t = 1 - c;
+            const double c = cosDegrees(a[3]), s = sinDegrees(a[3]), t = 1 - c;
             m.l[0][0] = c + t * k.x * k.x;
             m.l[0][1] = t * k.x * k.y - s * k.z;
             m.l[0][2] = t * k.x * k.z + s * k.y;
@@ -445,6 +432,18 @@ void primitiveArgs(const Graph& g, NodeId n, EvalState s, double* out) {
         if (!std::isfinite(out[i]))
             nonFinite(g, g.exprs[id], out[i], "the primitive argument", s.frame);
     }
+}
+
+double sinDegrees(double a) {
+    const double r = std::fmod(a, 360.0);
+    if (r == 0 || r == 180 || r == -180) return 0;
+    if (r == 90 || r == -270) return 1;
+    if (r == -90 || r == 270) return -1;
+    return std::sin(a * kDegToRad);
+}
+
+double cosDegrees(double a) {
+    return sinDegrees(a + 90.0);
 }
 
 void checkDepth(const Graph& g, NodeId n, uint32_t depth, EvalState s) {

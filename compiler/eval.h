@@ -100,6 +100,12 @@ void primitiveArgs(const Graph& g, NodeId primitiveNode, EvalState s, double* ou
 // g.scene.settings.maxDepth.
 void checkDepth(const Graph& g, NodeId selectNode, uint32_t depth, EvalState s);
 
+// sin and cos of an angle in degrees, exact at multiples of 90 so that rotz(90) maps +x
+// exactly to +y. The tracer's interval bounds use the same functions: their soundness
+// depends on it.
+double sinDegrees(double a);
+double cosDegrees(double a);
+
 // "c = 3, x = 0.5" for the slots assigned in a frame: for error messages.
 std::string describeFrame(const Graph& g, const double* frame);
 
