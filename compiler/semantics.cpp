@@ -5,7 +5,8 @@
 
 namespace pcsg {
 
-Semantics::Semantics(const Graph& g) : g_(g), fused_(g.nodes.size()) {
+Semantics::Semantics(const Graph& g)
+    : g_(g), maxDepth_(g.scene.settings.maxDepth), fused_(g.nodes.size()) {
     const size_t n = g.nodes.size();
     auto constantT = [&](NodeId m) {
         return g.nodes[m].kind == NodeKind::Transform && g.transforms[g.nodes[m].payload].constant;
@@ -23,53 +24,21 @@ Semantics::Semantics(const Graph& g) : g_(g), fused_(g.nodes.size()) {
             const Affine& mc = g.transforms[g.nodes[c].payload].matrix;
             f.forward = f.forward * mc;
             f.inverse = mc.inverse() * f.inverse;
+            ++f.length;
             c = g.child(c);
         }
         f.target = c;
     }
 }
 
-Step Semantics::enter(NodeId n, const PathState& s, StepScratch& scratch) const {
-    const Node& node = g_.nodes[n];
-    Step step;
-    step.state = s;
-    switch (node.kind) {
-        case NodeKind::Select: {
-            step.state.depth = selectDepth(n, s);
-            step.rule = selectRule(g_, n, EvalState{s.frame, s.path});
-            step.state.path = pathRule(s.path, step.rule);
-            step.child = g_.child(n, step.rule);
-            return step;
-        }
-        case NodeKind::Calc:
-            applyCalc(g_, n, EvalState{s.frame, s.path}, scratch.frame);
-            step.state.frame = scratch.frame;
-            step.child = g_.child(n);
-            return step;
-        case NodeKind::Transform: {
-            const Fused& f = fused_[n];
-            if (f.target != kNone) {
-                step.child = f.target;
-                step.forward = &f.forward;
-                step.inverse = &f.inverse;
-                return step;
-            }
-            scratch.forward = transformMatrix(g_, n, EvalState{s.frame, s.path});
-            scratch.inverse = scratch.forward.inverse();
-            step.child = g_.child(n);
-            step.forward = &scratch.forward;
-            step.inverse = &scratch.inverse;
-            return step;
-        }
-        case NodeKind::Paint:
-            step.state.material = node.payload;
-            step.child = g_.child(n);
-            return step;
-        case NodeKind::Operator:
-        case NodeKind::Primitive:
-            break;  // not unary: operand() and primitiveArgs()
-    }
-    return step;
+void Semantics::transformStep(NodeId n, const PathState& s, StepScratch& scratch,
+                              Step& step) const {
+    StepScratch::Matrices& m = scratch.matrices.emplace();
+    m.forward = transformMatrix(g_, n, EvalState{s.frame, s.path});
+    m.inverse = m.forward.inverse();
+    step.child = g_.child(n);
+    step.forward = &m.forward;
+    step.inverse = &m.inverse;
 }
 
 Affine Semantics::forwardThrough(const Affine& outer, NodeId n, const Step& st) const {

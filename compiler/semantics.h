@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "eval.h"
@@ -47,10 +48,14 @@ struct Step {
 };
 
 // Storage a walker lends to enter(): the new frame of a C-node (Graph::slotCount() values,
-// not the incoming frame) and the matrices of a T-node that depends on parameters.
+// not the incoming frame) and the matrices of a T-node that depends on parameters (made
+// only then: the walk takes a step per node of every ray).
 struct StepScratch {
+    struct Matrices {
+        Affine forward, inverse;
+    };
     double* frame = nullptr;
-    Affine forward, inverse;
+    std::optional<Matrices> matrices;
 };
 
 class Semantics {
@@ -63,13 +68,48 @@ class Semantics {
     // RuntimeError when it is beyond settings max_depth. Walkers that cull before they
     // select call this first, so that culling can never hide the error.
     uint32_t selectDepth(NodeId select, const PathState& s) const {
-        checkDepth(g_, select, s.depth + 1, EvalState{s.frame, s.path});
+        if (s.depth >= maxDepth_) checkDepth(g_, select, s.depth + 1, EvalState{s.frame, s.path});
         return s.depth + 1;
     }
 
     // Enters the unary node n from state s. Throws RuntimeError (without module path: the
-    // walker adds it as the error passes its S-nodes).
-    Step enter(NodeId n, const PathState& s, StepScratch& scratch) const;
+    // walker adds it as the error passes its S-nodes). Inline: the tracer takes this step
+    // at every node of every ray.
+    Step enter(NodeId n, const PathState& s, StepScratch& scratch) const {
+        const Node& node = g_.nodes[n];
+        Step step;
+        step.state = s;
+        switch (node.kind) {
+            case NodeKind::Select:
+                step.state.depth = selectDepth(n, s);
+                step.rule = selectRule(g_, n, EvalState{s.frame, s.path});
+                step.state.path = pathRule(s.path, step.rule);
+                step.child = g_.child(n, step.rule);
+                break;
+            case NodeKind::Calc:
+                applyCalc(g_, n, EvalState{s.frame, s.path}, scratch.frame);
+                step.state.frame = scratch.frame;
+                step.child = g_.child(n);
+                break;
+            case NodeKind::Transform:
+                if (fused_[n].target == kNone) {
+                    transformStep(n, s, scratch, step);
+                    break;
+                }
+                step.child = fused_[n].target;
+                step.forward = &fused_[n].forward;
+                step.inverse = &fused_[n].inverse;
+                break;
+            case NodeKind::Paint:
+                step.state.material = node.payload;
+                step.child = g_.child(n);
+                break;
+            case NodeKind::Operator:
+            case NodeKind::Primitive:
+                break;  // not unary: operand() and primitiveArgs()
+        }
+        return step;
+    }
 
     // outer * (the matrix of the T-step `st` taken at n), multiplied T-node by T-node along a
     // fused chain, so that a world matrix is the same product whether or not the chain's
@@ -90,13 +130,22 @@ class Semantics {
     NodeId fusedTarget(NodeId n) const { return fused_[n].target; }
     const Affine& fusedForward(NodeId n) const { return fused_[n].forward; }
     const Affine& fusedInverse(NodeId n) const { return fused_[n].inverse; }
+    // The graph nodes one step from n passes: the T-nodes of a fused chain, else 1.
+    uint32_t nodesInStep(NodeId n) const {
+        return fused_[n].target == kNone ? 1 : fused_[n].length;
+    }
 
   private:
+    // A T-node whose matrix depends on parameters: computed now, into `scratch`.
+    void transformStep(NodeId n, const PathState& s, StepScratch& scratch, Step& step) const;
+
     struct Fused {
         NodeId target = kNone;
+        uint32_t length = 1;  // T-nodes in the chain
         Affine forward, inverse;
     };
     const Graph& g_;
+    uint32_t maxDepth_;
     std::vector<Fused> fused_;  // per node
 };
 

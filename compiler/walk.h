@@ -154,7 +154,8 @@ class Walker {
 
     // S, C, T and paint nodes on the way down: the one step of semantics.h.
     void enterUnary(WalkEntry& e) {
-        sink_.visit();
+        // Every graph node the step passes counts (a sink's work limits and weights).
+        for (uint32_t k = sem_.nodesInStep(e.node); k-- > 0;) sink_.visit();
         const NodeKind kind = g_.nodes[e.node].kind;
         if (kind == NodeKind::Select && memoised(e)) return;
         StepScratch scratch;

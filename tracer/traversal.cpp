@@ -186,8 +186,9 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
 // instance instead; `transformBack(inv, walkBelow)` runs the walk below a T-node and
 // brings the normals it found back through the T-node.
 template <class Below, class Unrolled, class TransformBack>
-auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
-                   Unrolled unrolled, TransformBack transformBack) {
+[[gnu::always_inline]] inline auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c,
+                                                 double tmin, double tmax, Below below,
+                                                 Unrolled unrolled, TransformBack transformBack) {
     using Result = decltype(below(n, r, c));
     const Semantics& sem = scene_.sem_;
     const NodeKind kind = g_.nodes[n].kind;
