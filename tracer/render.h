@@ -1,5 +1,5 @@
 // Rendering an image: pixels in tiles, in parallel with oneTBB, anti-aliasing. The result
-// is linear float RGB; image files are written by the pcsg-image helper (tools/image_io.h).
+// is linear float RGB; tools/image/ writes it to a file.
 //
 //  - Every pixel's colour depends only on the pixel (fixed sample positions, no shared
 //    mutable state), so the image is the same byte for byte whatever the thread count.
