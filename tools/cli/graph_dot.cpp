@@ -6,6 +6,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "primitive_table.h"
+
 namespace pcsg::tools {
 
 namespace {
@@ -93,34 +95,6 @@ const char* transformName(TransformOp op) {
             return "matrix";
     }
     return "transform";
-}
-
-const char* primitiveName(PrimitiveKind k) {
-    switch (k) {
-        case PrimitiveKind::Sphere:
-            return "sphere";
-        case PrimitiveKind::Cube:
-            return "cube";
-        case PrimitiveKind::Cylinder:
-            return "cylinder";
-        case PrimitiveKind::Cone:
-            return "cone";
-        case PrimitiveKind::Tetrahedron:
-            return "tetrahedron";
-        case PrimitiveKind::Torus:
-            return "torus";
-        case PrimitiveKind::Plane:
-            return "plane";
-        case PrimitiveKind::Empty:
-            return "empty";
-        case PrimitiveKind::Tri1:
-            return "tri1";
-        case PrimitiveKind::Tri2:
-            return "tri2";
-        case PrimitiveKind::Triangle:
-            return "triangle";
-    }
-    return "primitive";
 }
 
 std::string materialName(const Graph& g, uint32_t m) {
