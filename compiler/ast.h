@@ -29,6 +29,7 @@ enum class ExKind : uint8_t {
     Power,   // a ^ b
     Call,    // the function (keyword or unknown identifier) at `tok`; arguments are
              // [first, first+count) of Ast::lists
+    Time,    // `clock` or `frame`: the keyword at `tok`
 };
 
 struct ExNode {

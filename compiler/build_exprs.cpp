@@ -129,7 +129,8 @@ ExprId ExprCompiler::compile(uint32_t e) {
     x.end = here();
     x.maxStack = cg.maxDepth;
     x.usesPath = cg.usesPath;
-    x.constant = !cg.readsSlot && !cg.usesPath;
+    x.usesTime = cg.usesTime;
+    x.constant = !cg.readsSlot && !cg.usesPath && !cg.usesTime;
     const ExNode& n = ctx_.ast.exprs[e];
     x.loc = ctx_.loc(n.from);
     x.text = sourceText(n.from, n.to);
@@ -176,6 +177,11 @@ void ExprCompiler::gen(uint32_t e, CodeGen& cg) {
         }
         case ExKind::Call:
             return call(n, cg);
+        case ExKind::Time:
+            emit(ctx_.tokens[n.tok].kw == Kw::Clock ? Op::Clock : Op::Frame);
+            cg.usesTime = true;
+            cg.push();
+            return;
     }
 }
 

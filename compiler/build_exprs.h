@@ -34,7 +34,7 @@ class ExprCompiler {
   private:
     struct CodeGen {
         uint32_t depth = 0, maxDepth = 0;
-        bool readsSlot = false, usesPath = false;
+        bool readsSlot = false, usesPath = false, usesTime = false;
         void push(uint32_t k = 1) {
             depth += k;
             maxDepth = std::max(maxDepth, depth);

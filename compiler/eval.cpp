@@ -246,6 +246,12 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
                 ++sp;
                 break;
             }
+            case Op::Clock:
+                stack[sp++] = g.time.clock;
+                break;
+            case Op::Frame:
+                stack[sp++] = g.time.frame;
+                break;
         }
     }
     return sp > 0 ? stack[sp - 1] : std::nan("");

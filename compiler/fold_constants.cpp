@@ -109,7 +109,9 @@ void refreshExpr(Graph& g, ExprId id) {
     if (e.constant) return;
     for (uint32_t pc = e.begin; pc < e.end; ++pc) {
         const Op op = g.code[pc].op;
-        if (op == Op::Load || op == Op::Rand0 || op == Op::Choose) return;
+        if (op == Op::Load || op == Op::Rand0 || op == Op::Choose || op == Op::Clock ||
+            op == Op::Frame)
+            return;
     }
     e.constant = true;
     if (e.end - e.begin > 1) {

@@ -89,6 +89,8 @@ enum class Op : uint8_t {
     Call,        // a = Func, argc = number of arguments popped (min/max take 2 or more)
     Rand0,       // rand(): push uniform [0,1) from (seed, instance path, call site a)
     Choose,      // choose(w1..wn): argc = n, call site a; pushes a rule number 1..n
+    Clock,       // push the graph's time: clock
+    Frame,       // push the graph's time: frame
 };
 
 struct Instr {
@@ -101,8 +103,9 @@ struct Instr {
 struct Expr {
     uint32_t begin = 0, end = 0;  // [begin, end) in Graph::code
     uint32_t maxStack = 0;        // the largest stack depth the code reaches
-    bool constant = false;        // reads no slot and calls no rand()/choose()
+    bool constant = false;        // reads no slot, no clock or frame, calls no rand()/choose()
     bool usesPath = false;        // calls rand() or choose(): depends on the instance path
+    bool usesTime = false;        // reads clock or frame
     FileLoc loc;
     std::string text;  // the source text, for run-time error messages
 };
@@ -240,6 +243,21 @@ struct Scene {
     Settings settings;
 };
 
+// The time of the frame being rendered (docs/language.md section 11), read by the
+// expressions `clock` and `frame`. A still image has clock 0 and frame 1.
+struct Time {
+    double clock = 0;
+    int frame = 1;
+};
+
+// A range of times: what an analysis that must hold for several frames (the tracer's
+// bounds of an animation) lets `clock` and `frame` be.
+struct TimeRange {
+    double clockLo = 0, clockHi = 0;
+    int frameLo = 1, frameHi = 1;
+    static TimeRange at(const Time& t) { return {t.clock, t.clock, t.frame, t.frame}; }
+};
+
 // ---------------------------------------------------------------------------------------
 
 struct Graph {
@@ -263,6 +281,7 @@ struct Graph {
 
     std::vector<Material> materials;  // materials[0] is the default material
     Scene scene;
+    Time time;  // the current frame's time: set it before rendering or expanding a frame
 
     // --- construction helpers (used by the builder and by tests) ---
     NodeId addNode(NodeKind kind, uint32_t payload, const std::vector<NodeId>& children,

@@ -80,6 +80,8 @@ constexpr KeywordEntry kKeywords[] = {
     {"choose", Kw::Choose},
     {"pi", Kw::Pi},
     {"e", Kw::E},
+    {"clock", Kw::Clock},
+    {"frame", Kw::Frame},
     {"sin", Kw::Sin},
     {"cos", Kw::Cos},
     {"tan", Kw::Tan},

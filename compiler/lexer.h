@@ -113,6 +113,8 @@ enum class Kw : uint8_t {
     Choose,
     Pi,
     E,
+    Clock,  // the time (section 11): read-only values
+    Frame,
     Sin,
     Cos,
     Tan,

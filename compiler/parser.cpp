@@ -246,6 +246,9 @@ class Parser {
     }
 
     uint32_t name(std::string_view what) {
+        if (at(Tok::Keyword) && (tok().kw == Kw::Clock || tok().kw == Kw::Frame))
+            fail(p_, fmt::format("'{}' is the time of the frame, read-only: it cannot name {}",
+                                 text(pos()), what));
         if (at(Tok::Keyword))
             fail(p_, fmt::format("'{}' is a keyword and cannot name {}", text(pos()), what));
         if (!at(Tok::Ident))
@@ -703,7 +706,8 @@ class Parser {
         return addExpr(n);
     }
 
-    // primary -> NUMBER | 'pi' | 'e' | IDENT | (FUNCTION | IDENT) args | '(' expr ')'
+    // primary -> NUMBER | 'pi' | 'e' | 'clock' | 'frame' | IDENT | (FUNCTION | IDENT) args | '('
+    // expr ')'
     uint32_t primary() {
         const Token& t = tok();
         ExNode n;
@@ -717,6 +721,11 @@ class Parser {
         if (t.isKw(Kw::Pi) || t.isKw(Kw::E)) {
             n.kind = ExKind::Number;
             n.value = t.kw == Kw::Pi ? std::numbers::pi : std::numbers::e;
+            ++p_;
+            return addExpr(n);
+        }
+        if (t.isKw(Kw::Clock) || t.isKw(Kw::Frame)) {
+            n.kind = ExKind::Time;
             ++p_;
             return addExpr(n);
         }

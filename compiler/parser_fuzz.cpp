@@ -50,6 +50,8 @@ void checkStack(const Graph& g, const Expr& e) {
             case Op::Const:
             case Op::Load:
             case Op::Rand0:
+            case Op::Clock:
+            case Op::Frame:
                 next = d + 1;
                 break;
             case Op::Neg:

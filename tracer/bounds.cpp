@@ -125,6 +125,7 @@ class Analysis {
     }
 
     AbstractFrame initialFrame() const { return AbstractFrame(g_.slotCount()); }
+    const TimeRange* time() const { return opt_.time ? &*opt_.time : nullptr; }
 
     // Evaluates a reached node in a state, records what the box pass needs, and calls
     // `push(child, state)` for every child it may reach.
@@ -135,7 +136,7 @@ class Analysis {
         switch (node.kind) {
             case NodeKind::Select: {
                 bool fails = false;
-                auto rules = reachableRules(g_, n, st, &fails);
+                auto rules = reachableRules(g_, n, st, &fails, time());
                 if (fails) rec.mayFail[moduleOf(n)] = 1;
                 for (uint32_t r : rules) push(g_.child(n, r), st);
                 auto& dst = rec.rules[moduleOf(n)];
@@ -145,7 +146,7 @@ class Analysis {
             }
             case NodeKind::Calc: {
                 AbstractFrame out;
-                if (applyCalcInterval(g_, n, st, out)) push(g_.child(n), out);
+                if (applyCalcInterval(g_, n, st, out, time())) push(g_.child(n), out);
                 return;
             }
             case NodeKind::Transform: {
@@ -155,7 +156,7 @@ class Analysis {
                     return;
                 }
                 IntervalAffine m;
-                if (!transformInterval(g_, n, st, m)) return;
+                if (!transformInterval(g_, n, st, m, time())) return;
                 if (rec.matrixOk[ti]) {
                     for (int i = 0; i < 3; ++i) {
                         for (int j = 0; j < 3; ++j)
@@ -179,7 +180,7 @@ class Analysis {
                 const int32_t pi = pIndex_[n];
                 if (pi < 0) return;
                 std::array<Interval, 9> a;
-                if (!primitiveArgsInterval(g_, n, st, a.data())) return;
+                if (!primitiveArgsInterval(g_, n, st, a.data(), time())) return;
                 const uint32_t count = g_.primitives[node.payload].argCount;
                 if (rec.argsOk[pi]) {
                     for (uint32_t i = 0; i < count; ++i)

@@ -33,6 +33,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "geometry.h"
@@ -67,6 +68,9 @@ struct BoundsOptions {
     int iterations = 60;
     // Apply the safety padding (tests of the raw analysis turn it off).
     bool pad = true;
+    // The times the boxes hold for (`clock` and `frame` range over them); none: the
+    // graph's time alone. An animation may compute its boxes once for all its frames.
+    std::optional<TimeRange> time;
 };
 
 Bounds computeBounds(const Graph& g, const BoundsOptions& options = {});

@@ -315,6 +315,7 @@ struct IntervalVm {
     const Graph& g;
     const AbstractFrame& frame;
     uint64_t seed;
+    TimeRange time;
     int forks = 0;
     static constexpr int kMaxForks = 64;
     std::vector<Interval>* leaves = nullptr;
@@ -419,6 +420,12 @@ struct IntervalVm {
                 stack.push_back(reals(1, in.argc));
                 break;
             }
+            case Op::Clock:
+                stack.push_back(Interval::of(time.clockLo, time.clockHi));
+                break;
+            case Op::Frame:
+                stack.push_back(Interval::of(time.frameLo, time.frameHi));
+                break;
             case Op::Jump:
             case Op::JumpIfZero:
                 break;  // run's
@@ -555,21 +562,22 @@ AbstractFrame widen(const AbstractFrame& prev, const AbstractFrame& next) {
     return out;
 }
 
-Interval evalInterval(const Graph& g, ExprId e, const AbstractFrame& frame) {
+Interval evalInterval(const Graph& g, ExprId e, const AbstractFrame& frame, const TimeRange* time) {
     const Expr& x = g.exprs[e];
-    IntervalVm vm{g, frame, g.scene.settings.seed};
+    IntervalVm vm{g, frame, g.scene.settings.seed, time ? *time : TimeRange::at(g.time)};
     std::vector<Interval> stack;
     stack.reserve(x.maxStack + 1);
     return vm.run(x.begin, x.end, std::move(stack));
 }
 
-bool applyCalcInterval(const Graph& g, NodeId n, const AbstractFrame& in, AbstractFrame& out) {
+bool applyCalcInterval(const Graph& g, NodeId n, const AbstractFrame& in, AbstractFrame& out,
+                       const TimeRange* time) {
     const Calc& c = g.calcs[g.nodes[n].payload];
     out = in;
     const Assignment* as = g.assignments.data() + c.first;
     if (!c.simultaneous) {
         for (uint32_t i = 0; i < c.count; ++i) {
-            const Interval v = evalInterval(g, as[i].value, out);
+            const Interval v = evalInterval(g, as[i].value, out, time);
             if (v.isBottom()) return false;
             out[as[i].slot] = AbstractSlot{v, false};
         }
@@ -577,17 +585,18 @@ bool applyCalcInterval(const Graph& g, NodeId n, const AbstractFrame& in, Abstra
     }
     std::vector<Interval> values(c.count);
     for (uint32_t i = 0; i < c.count; ++i) {
-        values[i] = evalInterval(g, as[i].value, in);
+        values[i] = evalInterval(g, as[i].value, in, time);
         if (values[i].isBottom()) return false;
     }
     for (uint32_t i = 0; i < c.count; ++i) out[as[i].slot] = AbstractSlot{values[i], false};
     return true;
 }
 
-std::vector<Interval> evalIntervalPaths(const Graph& g, ExprId e, const AbstractFrame& frame) {
+std::vector<Interval> evalIntervalPaths(const Graph& g, ExprId e, const AbstractFrame& frame,
+                                        const TimeRange* time) {
     const Expr& x = g.exprs[e];
     std::vector<Interval> leaves;
-    IntervalVm vm{g, frame, g.scene.settings.seed};
+    IntervalVm vm{g, frame, g.scene.settings.seed, time ? *time : TimeRange::at(g.time)};
     vm.leaves = &leaves;
     std::vector<Interval> stack;
     stack.reserve(x.maxStack + 1);
@@ -596,7 +605,7 @@ std::vector<Interval> evalIntervalPaths(const Graph& g, ExprId e, const Abstract
 }
 
 std::vector<uint32_t> reachableRules(const Graph& g, NodeId n, const AbstractFrame& frame,
-                                     bool* mayFail) {
+                                     bool* mayFail, const TimeRange* time) {
     const Module& m = g.modules[g.nodes[n].payload];
     const uint32_t rules = g.nodes[n].childCount;
     std::vector<uint32_t> out;
@@ -610,7 +619,7 @@ std::vector<uint32_t> reachableRules(const Graph& g, NodeId n, const AbstractFra
                 earlierMayFail = false;
                 break;
             }
-            const Interval v = evalInterval(g, c, frame);
+            const Interval v = evalInterval(g, c, frame, time);
             // A NaN or infinite condition is a run-time error.
             const bool canTrue = v.hasReals() && !(v.lo == 0 && v.hi == 0);
             const bool canFalse = v.contains(0);
@@ -622,7 +631,7 @@ std::vector<uint32_t> reachableRules(const Graph& g, NodeId n, const AbstractFra
     } else {
         // Path by path, so that the rules of an if-chain stay a set.
         std::vector<uint8_t> taken(rules, 0);
-        for (const Interval& v : evalIntervalPaths(g, m.select, frame)) {
+        for (const Interval& v : evalIntervalPaths(g, m.select, frame, time)) {
             if (v.nan) fails = true;
             if (!v.hasReals()) continue;
             const double lo = std::round(v.lo), hi = std::round(v.hi);
@@ -646,7 +655,8 @@ IntervalAffine IntervalAffine::of(const Affine& m) {
     return r;
 }
 
-bool transformInterval(const Graph& g, NodeId n, const AbstractFrame& frame, IntervalAffine& out) {
+bool transformInterval(const Graph& g, NodeId n, const AbstractFrame& frame, IntervalAffine& out,
+                       const TimeRange* time) {
     const Transform& t = g.transforms[g.nodes[n].payload];
     if (t.constant) {
         out = IntervalAffine::of(t.matrix);
@@ -655,7 +665,7 @@ bool transformInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Int
     Interval a[12];
     bool points = true;
     for (uint32_t i = 0; i < t.argCount; ++i) {
-        a[i] = finiteArg(evalInterval(g, g.args[t.firstArg + i], frame));
+        a[i] = finiteArg(evalInterval(g, g.args[t.firstArg + i], frame, time));
         if (!a[i].hasReals()) return false;
         points = points && a[i].isPoint();
     }
@@ -668,14 +678,15 @@ bool transformInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Int
     return transformOfIntervals(t.op, a, out);
 }
 
-bool primitiveArgsInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Interval* out) {
+bool primitiveArgsInterval(const Graph& g, NodeId n, const AbstractFrame& frame, Interval* out,
+                           const TimeRange* time) {
     const Primitive& p = g.primitives[g.nodes[n].payload];
     if (p.constant) {
         for (size_t i = 0; i < p.values.size(); ++i) out[i] = Interval::point(p.values[i]);
         return true;
     }
     for (uint32_t i = 0; i < p.argCount; ++i) {
-        out[i] = finiteArg(evalInterval(g, g.args[p.firstArg + i], frame));
+        out[i] = finiteArg(evalInterval(g, g.args[p.firstArg + i], frame, time));
         if (!out[i].hasReals()) return false;
     }
     return true;

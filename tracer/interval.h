@@ -53,23 +53,28 @@ bool joinInto(AbstractFrame& a, const AbstractFrame& b);
 // Widening: bounds of `next` that moved beyond `prev` go to infinity. Returns next widened.
 AbstractFrame widen(const AbstractFrame& prev, const AbstractFrame& next);
 
+// `time`, in the functions below: the times `clock` and `frame` range over; nullptr: the
+// graph's time alone (Graph::time).
+//
 // Evaluates an expression on intervals (bottom when every evaluation fails). The seed is
 // the scene's, so that rand(x) of a known x is known.
-Interval evalInterval(const Graph& g, ExprId e, const AbstractFrame& frame);
+Interval evalInterval(const Graph& g, ExprId e, const AbstractFrame& frame,
+                      const TimeRange* time = nullptr);
 
 // The same, path by path: one interval per way through the expression's `if`s and
 // short-circuit operators (their union is evalInterval's result, up to the join).
-std::vector<Interval> evalIntervalPaths(const Graph& g, ExprId e, const AbstractFrame& frame);
+std::vector<Interval> evalIntervalPaths(const Graph& g, ExprId e, const AbstractFrame& frame,
+                                        const TimeRange* time = nullptr);
 
 // A C-node on intervals: false when every evaluation fails (the child is unreachable).
-bool applyCalcInterval(const Graph& g, NodeId calcNode, const AbstractFrame& in,
-                       AbstractFrame& out);
+bool applyCalcInterval(const Graph& g, NodeId calcNode, const AbstractFrame& in, AbstractFrame& out,
+                       const TimeRange* time = nullptr);
 
 // The rules (0-based) an S-node may select in the frame; empty when every selection fails.
 // `mayFail`, when given, is set when the selection may be a run-time error for some values
 // in the frame (a rule number out of range or not finite, no notation-B condition true).
 std::vector<uint32_t> reachableRules(const Graph& g, NodeId selectNode, const AbstractFrame& frame,
-                                     bool* mayFail = nullptr);
+                                     bool* mayFail = nullptr, const TimeRange* time = nullptr);
 
 // An affine map whose entries are intervals: it stands for every matrix with entries in
 // them. transformBox applies all of them to a box (zero times an unbounded side is zero:
@@ -84,12 +89,12 @@ struct IntervalAffine {
 // arguments are run-time errors and are left out). Returns false when every evaluation
 // fails.
 bool transformInterval(const Graph& g, NodeId transformNode, const AbstractFrame& frame,
-                       IntervalAffine& out);
+                       IntervalAffine& out, const TimeRange* time = nullptr);
 
 // The arguments a primitive may have (torus R r, triangle corners); false when every
 // evaluation fails. `out` gets one interval per argument.
 bool primitiveArgsInterval(const Graph& g, NodeId primitiveNode, const AbstractFrame& frame,
-                           Interval* out);
+                           Interval* out, const TimeRange* time = nullptr);
 
 Box transformBox(const IntervalAffine& m, const Box& b);
 

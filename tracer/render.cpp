@@ -214,7 +214,9 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
     result.width = opt.width;
     result.height = opt.height;
     const auto t0 = Clock::now();
-    Bounds bounds = computeBounds(g);
+    BoundsOptions boundsOptions;
+    boundsOptions.time = opt.boundsTime;
+    Bounds bounds = computeBounds(g, boundsOptions);
     result.infiniteBoxes = bounds.infiniteNodes;
     const auto t1 = Clock::now();
     result.boundsSeconds = std::chrono::duration<double>(t1 - t0).count();

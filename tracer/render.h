@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct RenderOptions {
     int adaptiveDepth = 3;  // POV-Ray's +R
     int threads = 0;        // 0: all cores
     bool useBounds = true;  // tests compare against rendering without culling
+    // The times the hyper-bounding boxes are computed for; none: the graph's time alone.
+    // (The image is the same either way: a wider range only culls less.)
+    std::optional<TimeRange> boundsTime;
     // Exact boxes of S-node instances where the static ones are loose (instance_boxes.h),
     // kept in a table of at most this many bytes.
     bool instanceBoxes = true;
