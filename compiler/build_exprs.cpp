@@ -68,15 +68,35 @@ Slot ExprCompiler::slotOf(std::string_view name) {
 }
 
 std::optional<double> ExprCompiler::constant(uint32_t e) {
+    const auto v = directiveExpr(e, false);
+    if (!v) return std::nullopt;
+    return v->value;
+}
+
+std::optional<ExprCompiler::DirectiveValue> ExprCompiler::directiveValue(uint32_t e) {
+    return directiveExpr(e, true);
+}
+
+std::optional<ExprCompiler::DirectiveValue> ExprCompiler::directiveExpr(uint32_t e,
+                                                                        bool allowTime) {
     const size_t codeSize = g_.code.size(), exprCount = g_.exprs.size();
     const uint32_t sites = g_.randCallSites;
     constantOnly_ = true;
     const size_t errors = ctx_.diags.count();
     const ExprId id = compile(e);
     constantOnly_ = false;
-    std::optional<double> value;
+    std::optional<DirectiveValue> value;
+    const Expr& x = g_.exprs[id];
+    if (ctx_.diags.count() == errors && x.usesTime && !x.usesPath && allowTime) {
+        // kept: evaluated again at each frame's time
+        return DirectiveValue{evalExpr(g_, id, EvalState{nullptr, kRootPath}), id};
+    }
     if (ctx_.diags.count() != errors) {
         // reported already (a parameter, rand(), a syntax error): nothing to evaluate
+    } else if (x.usesTime) {
+        ctx_.error(
+            ctx_.ast.exprs[e].from,
+            fmt::format("'{}' reads the time (clock, frame): settings are constants", x.text));
     } else if (!g_.exprs[id].constant) {
         // compile() reports every way to be non-constant; should it miss one, this
         // error stands in for it, as evaluating needs a frame there is none of
@@ -85,7 +105,7 @@ std::optional<double> ExprCompiler::constant(uint32_t e) {
     } else {
         const double v = evalExpr(g_, id, EvalState{nullptr, kRootPath});
         if (std::isfinite(v))
-            value = v;
+            value = DirectiveValue{v, kNone};
         else
             ctx_.error(ctx_.ast.exprs[e].from,
                        fmt::format("'{}' is {}, not a finite number", g_.exprs[id].text, v));

@@ -27,6 +27,15 @@ class ExprCompiler {
     // evaluated and dropped from the graph's code. Nothing when an error was reported.
     std::optional<double> constant(uint32_t e);
 
+    // The same, but the expression may also read `clock` and `frame` (section 11): then
+    // it stays in the graph's code as `timed`, and `value` is its value at the graph's
+    // time (not checked: setTime() checks it at each frame's time).
+    struct DirectiveValue {
+        double value = 0;
+        ExprId timed = kNone;
+    };
+    std::optional<DirectiveValue> directiveValue(uint32_t e);
+
     // The slot of a parameter (Graph::slot searches linearly: fine for a handful of
     // names, not for a generated file with thousands).
     Slot slotOf(std::string_view name);
@@ -43,6 +52,7 @@ class ExprCompiler {
     };
 
     uint32_t emit(Op op, uint32_t a = 0, double imm = 0, uint8_t argc = 0);
+    std::optional<DirectiveValue> directiveExpr(uint32_t e, bool allowTime);
     uint32_t here() const { return static_cast<uint32_t>(g_.code.size()); }
     std::string sourceText(uint32_t from, uint32_t to) const;
 

@@ -27,17 +27,29 @@ class DirectiveReader {
     bool once(uint32_t& seen, const Stmt& s, const char* what);
     template <class F>
     void items(const Stmt& s, const char* what, const char* known, F set);
-    std::optional<Vec3> vectorValue(const DirectiveItem& item);
-    std::optional<Vec3> wantVector(const DirectiveItem& item);
-    std::optional<double> wantScalar(const DirectiveItem& item);
+    std::optional<double> value(uint32_t e, uint8_t field);
+    std::optional<Vec3> vectorValue(const DirectiveItem& item, uint8_t field);
+    std::optional<Vec3> wantVector(const DirectiveItem& item, uint8_t field);
+    std::optional<double> wantScalar(const DirectiveItem& item, uint8_t field);
     void checkCamera(const Stmt& s);
+    // Where the values read next go, should they read the time (TimedValue).
+    void target(DirectiveTarget t, uint32_t index = 0) {
+        target_ = t;
+        index_ = index;
+    }
 
     BuildContext& ctx_;
     Graph& g_;
     const Ast& ast_;
     ExprCompiler& exprs_;
     uint32_t settingsSeen_ = kNoNode, cameraSeen_ = kNoNode, backgroundSeen_ = kNoNode;
+    DirectiveTarget target_ = DirectiveTarget::Camera;
+    uint32_t index_ = 0;
+    bool timed_ = false;  // the last value read reads the time
 };
+
+// kSetting as the field: a settings value, which must be a constant.
+constexpr uint8_t kSetting = 255;
 
 // Whether this is the first directive of a kind that is given once; reports a second.
 bool DirectiveReader::once(uint32_t& seen, const Stmt& s, const char* what) {
@@ -62,11 +74,25 @@ void DirectiveReader::items(const Stmt& s, const char* what, const char* known, 
     }
 }
 
-std::optional<Vec3> DirectiveReader::vectorValue(const DirectiveItem& item) {
+// A directive's value: a constant, or for other directives than settings one that reads
+// the time, recorded as a TimedValue of the current target.
+std::optional<double> DirectiveReader::value(uint32_t e, uint8_t field) {
+    timed_ = false;
+    if (field == kSetting) return exprs_.constant(e);
+    const auto v = exprs_.directiveValue(e);
+    if (!v) return std::nullopt;
+    if (v->timed != kNone) {
+        g_.timedValues.push_back(TimedValue{target_, index_, field, v->timed});
+        timed_ = true;
+    }
+    return v->value;
+}
+
+std::optional<Vec3> DirectiveReader::vectorValue(const DirectiveItem& item, uint8_t field) {
     Vec3 v;
     bool ok = true;
     for (int i = 0; i < 3; ++i) {
-        const auto c = exprs_.constant(item.e[i]);
+        const auto c = value(item.e[i], static_cast<uint8_t>(field + i));
         if (c)
             v[i] = *c;
         else
@@ -76,22 +102,22 @@ std::optional<Vec3> DirectiveReader::vectorValue(const DirectiveItem& item) {
     return v;
 }
 
-std::optional<Vec3> DirectiveReader::wantVector(const DirectiveItem& item) {
+std::optional<Vec3> DirectiveReader::wantVector(const DirectiveItem& item, uint8_t field) {
     if (!item.vector) {
         ctx_.error(item.nameTok,
                    fmt::format("'{}' takes a vector '<x, y, z>'", clip(ctx_.text(item.nameTok))));
         return std::nullopt;
     }
-    return vectorValue(item);
+    return vectorValue(item, field);
 }
 
-std::optional<double> DirectiveReader::wantScalar(const DirectiveItem& item) {
+std::optional<double> DirectiveReader::wantScalar(const DirectiveItem& item, uint8_t field) {
     if (item.vector) {
         ctx_.error(item.nameTok,
                    fmt::format("'{}' takes a number, not a vector", clip(ctx_.text(item.nameTok))));
         return std::nullopt;
     }
-    return exprs_.constant(item.e[0]);
+    return value(item.e[0], field);
 }
 
 void DirectiveReader::settings(const Stmt& s) {
@@ -99,7 +125,7 @@ void DirectiveReader::settings(const Stmt& s) {
     Settings& st = g_.scene.settings;
     items(s, "settings", "seed, max_depth", [&](std::string_view n, const DirectiveItem& item) {
         if (n == "seed") {
-            if (auto v = wantScalar(item)) {
+            if (auto v = wantScalar(item, kSetting)) {
                 if (*v < 0 || *v != std::floor(*v) || *v > 9007199254740992.0)
                     ctx_.error(
                         item.nameTok,
@@ -108,7 +134,7 @@ void DirectiveReader::settings(const Stmt& s) {
                     st.seed = static_cast<uint64_t>(*v);
             }
         } else if (n == "max_depth") {
-            if (auto v = wantScalar(item)) {
+            if (auto v = wantScalar(item, kSetting)) {
                 if (*v < 1 || *v != std::floor(*v) || *v > kMaxMaxDepth)
                     ctx_.error(
                         item.nameTok,
@@ -127,19 +153,20 @@ void DirectiveReader::settings(const Stmt& s) {
 void DirectiveReader::camera(const Stmt& s) {
     if (!once(cameraSeen_, s, "camera")) return;
     Camera& c = g_.scene.camera;
+    target(DirectiveTarget::Camera);
     bool ok = true;
     items(s, "camera", "location, look_at, sky, angle",
           [&](std::string_view n, const DirectiveItem& item) {
               std::optional<Vec3> v;
               if (n == "location") {
-                  if ((v = wantVector(item))) c.location = *v;
+                  if ((v = wantVector(item, 0))) c.location = *v;
               } else if (n == "look_at") {
-                  if ((v = wantVector(item))) c.lookAt = *v;
+                  if ((v = wantVector(item, 3))) c.lookAt = *v;
               } else if (n == "sky") {
-                  if ((v = wantVector(item))) c.sky = *v;
+                  if ((v = wantVector(item, 6))) c.sky = *v;
               } else if (n == "angle") {
-                  if (auto a = wantScalar(item)) {
-                      if (!(*a > 0 && *a < 180)) {
+                  if (auto a = wantScalar(item, 9)) {
+                      if (!timed_ && !(*a > 0 && *a < 180)) {
                           ctx_.error(item.nameTok,
                                      fmt::format("the camera angle must be between 0 and 180 "
                                                  "degrees, found {}",
@@ -157,8 +184,11 @@ void DirectiveReader::camera(const Stmt& s) {
     if (ok) checkCamera(s);
 }
 
-// A camera that can see: a viewing direction, and a sky that is not along it.
+// A camera that can see: a viewing direction, and a sky that is not along it. (A camera
+// that moves is checked at each frame's time, by setTime().)
 void DirectiveReader::checkCamera(const Stmt& s) {
+    for (const TimedValue& tv : g_.timedValues)
+        if (tv.target == DirectiveTarget::Camera) return;
     const Camera& c = g_.scene.camera;
     const Vec3 dir = c.lookAt - c.location;
     if (length(dir) == 0)
@@ -169,11 +199,12 @@ void DirectiveReader::checkCamera(const Stmt& s) {
 
 void DirectiveReader::light(const Stmt& s) {
     Light l;
+    target(DirectiveTarget::Light, static_cast<uint32_t>(g_.scene.lights.size()));
     items(s, "light", "position, color", [&](std::string_view n, const DirectiveItem& item) {
         if (n == "position") {
-            if (auto v = wantVector(item)) l.position = *v;
+            if (auto v = wantVector(item, 0)) l.position = *v;
         } else if (n == "color" || n == "colour") {
-            if (auto v = wantVector(item)) l.color = *v;
+            if (auto v = wantVector(item, 3)) l.color = *v;
         } else {
             return false;
         }
@@ -184,28 +215,31 @@ void DirectiveReader::light(const Stmt& s) {
 
 void DirectiveReader::background(const Stmt& s) {
     if (!once(backgroundSeen_, s, "background")) return;
-    if (auto v = vectorValue(ast_.items[s.first])) g_.scene.background = *v;
+    target(DirectiveTarget::Background);
+    if (auto v = vectorValue(ast_.items[s.first], 0)) g_.scene.background = *v;
 }
 
 void DirectiveReader::material(const Stmt& s, const Names& names) {
     auto it = names.materialOfName.find(s.nameTok);
     if (it == names.materialOfName.end()) return;  // a duplicate, reported
     Material& m = g_.materials[it->second];
+    target(DirectiveTarget::Material, it->second);
     items(s, "material", "color, ambient, diffuse, phong, phong_size, reflection",
           [&](std::string_view n, const DirectiveItem& item) {
               if (n == "color" || n == "colour") {
-                  if (auto v = wantVector(item)) m.color = *v;
+                  if (auto v = wantVector(item, 0)) m.color = *v;
                   return true;
               }
-              double* target = n == "ambient"      ? &m.ambient
-                               : n == "diffuse"    ? &m.diffuse
-                               : n == "phong"      ? &m.phong
-                               : n == "phong_size" ? &m.phongSize
-                               : n == "reflection" ? &m.reflection
-                                                   : nullptr;
-              if (!target) return false;
-              if (auto v = wantScalar(item)) *target = *v;
-              return true;
+              static constexpr const char* kScalars[] = {"ambient", "diffuse", "phong",
+                                                         "phong_size", "reflection"};
+              double* const fields[] = {&m.ambient, &m.diffuse, &m.phong, &m.phongSize,
+                                        &m.reflection};
+              for (uint8_t i = 0; i < 5; ++i) {
+                  if (n != kScalars[i]) continue;
+                  if (auto v = wantScalar(item, static_cast<uint8_t>(3 + i))) *fields[i] = *v;
+                  return true;
+              }
+              return false;
           });
 }
 

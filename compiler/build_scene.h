@@ -1,6 +1,7 @@
 // The builder's scene phase: the directives camera, light, background, material and
 // settings (docs/language.md section 7) read into Graph::scene and Graph::materials. Their
-// values are constants (ExprCompiler::constant); material names are registered before,
+// values are constants (ExprCompiler::constant), or read the time (section 11) and are
+// kept as Graph::timedValues for setTime() (scene_time.h); material names are registered before,
 // by build_names.h, so that paint() may name a material defined later in the file.
 #pragma once
 

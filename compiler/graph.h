@@ -206,7 +206,9 @@ struct Primitive {
 };
 
 // ---------------------------------------------------------------------------------------
-// Scene directives (docs/language.md section 7). All values are constants.
+// Scene directives (docs/language.md section 7). Their values are constants, or read the
+// time (section 11): such a value is a TimedValue, which setTime() (scene_time.h)
+// evaluates into the Scene and the materials for each frame.
 
 struct Camera {
     Vec3 location{0, -5, 2};
@@ -258,6 +260,20 @@ struct TimeRange {
     static TimeRange at(const Time& t) { return {t.clock, t.clock, t.frame, t.frame}; }
 };
 
+// A directive's value that reads `clock` or `frame`, and the number it sets:
+//   Camera:     location x y z (fields 0-2), look_at (3-5), sky (6-8), angle (9)
+//   Light:      lights[index]: position (0-2), color (3-5)
+//   Background: x y z (0-2)
+//   Material:   materials[index]: color (0-2), ambient (3), diffuse (4), phong (5),
+//               phong_size (6), reflection (7)
+enum class DirectiveTarget : uint8_t { Camera, Light, Background, Material };
+struct TimedValue {
+    DirectiveTarget target;
+    uint32_t index = 0;
+    uint8_t field = 0;
+    ExprId expr = kNone;
+};
+
 // ---------------------------------------------------------------------------------------
 
 struct Graph {
@@ -281,7 +297,8 @@ struct Graph {
 
     std::vector<Material> materials;  // materials[0] is the default material
     Scene scene;
-    Time time;  // the current frame's time: set it before rendering or expanding a frame
+    Time time;  // the current frame's time: set it (setTime) before rendering a frame
+    std::vector<TimedValue> timedValues;  // directive values that read the time
 
     // --- construction helpers (used by the builder and by tests) ---
     NodeId addNode(NodeKind kind, uint32_t payload, const std::vector<NodeId>& children,
