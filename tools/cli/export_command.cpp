@@ -39,6 +39,7 @@ struct ExportOptions {
     int width = 640, height = 480;
     uint32_t maxUnion = 32;
     bool json = false;
+    double clock = 0;  // --clock: the frame's time
 };
 
 // Unrolls the graph; nullopt (with the error printed) when the scene is at fault.
@@ -121,9 +122,10 @@ void printExport(const ExportOptions& o, const Stats& s, const PovWriteStats& wr
 }
 
 int runExport(const ExportOptions& o) {
-    const CompiledScene compiled = compileScene(o.scene, std::cerr);
+    CompiledScene compiled = compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
-    const Graph& g = *compiled.graph;
+    Graph& g = *compiled.graph;
+    if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
 
     const auto start = std::chrono::steady_clock::now();
     const std::optional<ExpandedTree> tree = expandScene(g, o);
@@ -189,6 +191,7 @@ void addExportCommand(CLI::App& app, int& status) {
                    "this many per level")
         ->capture_default_str()
         ->check(CLI::Range(2u, 100000u));
+    addClockOption(ex, e->clock);
     ex->add_flag("--json", e->json, "Print the export's figures as JSON");
     ex->callback([e, &status] { status = runExport(*e); });
 }

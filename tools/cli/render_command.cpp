@@ -54,6 +54,7 @@ struct RenderCommandOptions {
     size_t boxCacheMb = 64;
     size_t expansionCacheMb = 16;
     uint64_t countVisits = 20'000'000;
+    double clock = 0;  // --clock: the still's time
 };
 
 // A progress bar on standard error, redrawn at most every 1%.
@@ -216,9 +217,10 @@ int runRender(const RenderCommandOptions& o) {
         }
         imageHelper = *found;
     }
-    const CompiledScene compiled = compileScene(o.scene, std::cerr);
+    CompiledScene compiled = compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
-    const Graph& g = *compiled.graph;
+    Graph& g = *compiled.graph;
+    if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
 
     RenderReport report;
     if (const int status = countAndRender(g, o, report)) return status;
@@ -293,6 +295,7 @@ void addRenderCommand(CLI::App& app, int& status) {
                     "same whatever the count")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
+    addClockOption(cmd, o->clock);
     cmd->add_flag("--json", o->json, "Print the figures as JSON");
     cmd->add_flag("--no-bounds", o->noBounds,
                   "Do not cull with hyper-bounding boxes (slow; for checking that culling never "

@@ -71,8 +71,10 @@ RenderRun exportPov(const std::string& scene, const std::string& out, int width,
     return runPcsg("export-pov", argv);
 }
 
-RenderRun expandedStats(const std::string& scene) {
-    return runPcsg("stats", {"stats", scene, "--json"});
+RenderRun expandedStats(const std::string& scene, const std::vector<std::string>& extra) {
+    std::vector<std::string> argv = {"stats", scene, "--json"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return runPcsg("stats", argv);
 }
 
 RenderRun renderPovray(const std::string& pov, const std::string& out, int width, int height,

@@ -28,8 +28,8 @@ RenderRun renderNative(const std::string& scene, const std::string& out, int wid
 RenderRun exportPov(const std::string& scene, const std::string& out, int width, int height,
                     const std::vector<std::string>& extra = {});
 
-// `pcsg stats SCENE --json`.
-RenderRun expandedStats(const std::string& scene);
+// `pcsg stats SCENE --json` (and `extra`, e.g. --clock).
+RenderRun expandedStats(const std::string& scene, const std::vector<std::string>& extra = {});
 
 // `povray +I... +O... +W +H -D +FN -UA -P -V [extra...]` (extra: "-A", "+A0.3", "+WT2").
 // `started` false in the result when POV-Ray is not installed.

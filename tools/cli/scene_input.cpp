@@ -1,11 +1,15 @@
 #include "scene_input.h"
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <iterator>
 
 #include "compiler.h"
+#include "eval.h"
+#include "scene_time.h"
 
 namespace pcsg::tools {
 
@@ -28,6 +32,33 @@ CompiledScene compileScene(const std::string& path, std::ostream& err) {
     if (diags.hasErrors()) err << diags.format() << std::flush;
     if (diags.hasErrors()) result.graph.reset();
     return result;
+}
+
+bool setSceneTime(Graph& g, Time t, std::ostream& err) {
+    try {
+        setTime(g, t);
+        return true;
+    } catch (const RuntimeError& e) {
+        err << e.format(g) << "\n";
+        return false;
+    }
+}
+
+CLI::Option* addClockOption(CLI::App* cmd, double& clock) {
+    const CLI::Validator finite(
+        [](const std::string& s) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(s.c_str(), &end);
+            if (s.empty() || *end != '\0' || !std::isfinite(v))
+                return "a finite number is needed, found '" + s + "'";
+            return {};
+        },
+        "FINITE");
+    return cmd
+        ->add_option("--clock", clock,
+                     "The time of the still (docs/language.md section 11): `clock` reads this "
+                     "value and `frame` reads 1 (default: clock 0)")
+        ->check(finite);
 }
 
 }  // namespace pcsg::tools

@@ -24,12 +24,14 @@ struct StatsOptions {
     std::string scene;
     bool json = false;
     uint64_t maxVisits = 4'000'000'000ULL;
+    double clock = 0;  // --clock: the frame counted
 };
 
 int runStats(const StatsOptions& o) {
-    const CompiledScene compiled = compileScene(o.scene, std::cerr);
+    CompiledScene compiled = compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
-    const Graph& g = *compiled.graph;
+    Graph& g = *compiled.graph;
+    if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
     const auto start = std::chrono::steady_clock::now();
     ExpansionCount count;
     try {
@@ -80,6 +82,7 @@ void addStatsCommand(CLI::App& app, int& status) {
         "The expanded tree's size (primitives, nodes, bytes) beside the cyclic graph's bytes: "
         "the memory the graph saves, counted without building the tree");
     st->add_option("scene", s->scene, "The .pcsg file (- reads standard input)")->required();
+    addClockOption(st, s->clock);
     st->add_flag("--json", s->json, "Print the figures as JSON");
     st->add_option("--max-visits", s->maxVisits,
                    "Work limit of the counting pass in graph-node visits (stochastic systems "

@@ -26,6 +26,7 @@
 #include "commands.h"
 #include "image_helper.h"
 #include "renders.h"
+#include "scene_input.h"
 #include "stats.h"
 #include "verify_report.h"
 #include "verify_result.h"
@@ -44,6 +45,12 @@ struct VerifyOptions : VerifySettings {
     bool json = false;
     bool keep = false;
     std::string imageHelper;  // pcsg-image
+    double clock = 0;         // --clock: both sides render the still at this time
+    // The arguments that pass --clock on to render and export-pov (none without it).
+    std::vector<std::string> clockArgs() const {
+        if (clock == 0) return {};
+        return {"--clock", fmt::format("{}", clock)};
+    }
 };
 
 // The scene's text for the report (up to 256 KB); empty when it cannot be read.
@@ -60,11 +67,12 @@ std::string readSource(const std::string& scene) {
 
 // Step 1, the native render of the cyclic graph; false (with the message) when it failed.
 bool renderNativeSide(SceneResult& r, const VerifyOptions& o, const fs::path& work) {
-    const std::vector<std::string> threads =
+    std::vector<std::string> extra =
         o.threads > 0 ? std::vector<std::string>{"--threads", std::to_string(o.threads)}
                       : std::vector<std::string>{};
+    for (const std::string& a : o.clockArgs()) extra.push_back(a);
     const RenderRun native = renderNative(r.scene, (work / "native_full.png").string(),
-                                          o.width * o.ss, o.height * o.ss, threads);
+                                          o.width * o.ss, o.height * o.ss, extra);
     if (!native.ok) {
         r.message = native.error;
         return false;
@@ -84,7 +92,7 @@ bool renderNativeSide(SceneResult& r, const VerifyOptions& o, const fs::path& wo
 // Step 2, the expanded tree: its size, and the POV-Ray text (exported, or --pov's).
 // Returns the POV-Ray file, empty when the export failed.
 fs::path exportSide(SceneResult& r, const VerifyOptions& o, const fs::path& work) {
-    const RenderRun stats = expandedStats(r.scene);
+    const RenderRun stats = expandedStats(r.scene, o.clockArgs());
     r.expandedBytes = jsonField<uint64_t>(stats.json, "expanded_bytes");
     r.expandedNodes = jsonField<uint64_t>(stats.json, "expanded_nodes");
     r.primitives = jsonField<uint64_t>(stats.json, "primitive_equivalence");
@@ -95,7 +103,8 @@ fs::path exportSide(SceneResult& r, const VerifyOptions& o, const fs::path& work
         return o.povFile;
     }
     const fs::path pov = work / (r.dir + ".pov");
-    const RenderRun exported = exportPov(r.scene, pov.string(), o.width * o.ss, o.height * o.ss);
+    const RenderRun exported =
+        exportPov(r.scene, pov.string(), o.width * o.ss, o.height * o.ss, o.clockArgs());
     if (!exported.ok) {
         r.message = exported.error;
         return {};
@@ -353,6 +362,7 @@ void addVerifyCommand(CLI::App& app, int& status) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--report", o->reportDir,
                     "Write an HTML report into this directory; open DIR/index.html");
+    addClockOption(cmd, o->clock);
     cmd->add_option("--pov", o->povFile, "Render this POV-Ray file instead of exporting the scene");
     cmd->add_option("--pixel-threshold", o->thresholds.pixelOff,
                     "A pixel is off when a channel differs by more than this (0..1)")
