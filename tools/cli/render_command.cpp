@@ -1,5 +1,6 @@
 // pcsg render SCENE -o OUT [--width W] [--height H] [--aa N] [--adaptive T] [--threads N]
-//                          [--json]
+//                          [--clock X | --frames N [--clock-range A,B] [--cyclic]
+//                          [--subset F,L]] [--json]
 // Ray traces the scene's cyclic graph directly (tracer/): the graph is never expanded.
 // Prints the figures of the paper's Table 1 and more (tools/cli/stats.h).
 //
@@ -9,6 +10,10 @@
 // run once the pixels exist, which gets them through a pipe. The peak RSS printed is the
 // whole command's (this process's, or the helper's when that is larger), what
 // /usr/bin/time -v reports; the helper's own is printed beside it.
+//
+// With --frames N the scene compiles once and each frame sets its time (frames.h) and is
+// rendered and written exactly as a still at that time would be; a run-time error at frame
+// k names the frame and the clock and keeps the frames written before it.
 //
 // Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
 // run-time error of docs/language.md, reported once with its module path; no image is
@@ -25,15 +30,19 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <tuple>
+#include <vector>
 
 #include "commands.h"
 #include "eval.h"
 #include "expander.h"
+#include "frames.h"
 #include "image_format.h"
 #include "image_helper.h"
 #include "png_writer.h"
 #include "render.h"
 #include "scene_input.h"
+#include "scene_time.h"
 #include "stats.h"
 #include "traversal.h"
 
@@ -55,6 +64,9 @@ struct RenderCommandOptions {
     size_t expansionCacheMb = 16;
     uint64_t countVisits = 20'000'000;
     double clock = 0;  // --clock: the still's time
+    int frames = 0;    // --frames N: a sequence (0: a still)
+    std::string clockRange, subset;
+    bool cyclic = false;
 };
 
 // A progress bar on standard error, redrawn at most every 1%.
@@ -130,7 +142,8 @@ tracer::RenderOptions tracerOptions(const RenderCommandOptions& o) {
 
 // Counts the expansion and renders; returns the exit status (0, or 1 and 2 with the
 // error printed).
-int countAndRender(const Graph& g, const RenderCommandOptions& o, RenderReport& report) {
+int countAndRender(const Graph& g, const RenderCommandOptions& o, RenderReport& report,
+                   const std::string& frameNote = {}) {
     // Primitive equivalence: what the expanded tree would hold, counted without building
     // it. The count walks every path of the expansion (memoised), so it also finds the
     // scene's run-time errors on paths no ray visits.
@@ -145,11 +158,11 @@ int countAndRender(const Graph& g, const RenderCommandOptions& o, RenderReport& 
         report.result = tracer::render(g, ro);
     } catch (const RuntimeError& e) {
         if (showProgress) bar->finish();
-        std::cerr << e.format(g) << "\n";
+        std::cerr << e.format(g) << frameNote << "\n";
         return 1;
     } catch (const std::exception& e) {
         if (showProgress) bar->finish();
-        std::cerr << "pcsg render: error: " << o.scene << ": " << e.what() << "\n";
+        std::cerr << "pcsg render: error: " << o.scene << ": " << e.what() << frameNote << "\n";
         return 2;
     }
     if (showProgress) bar->finish();
@@ -182,6 +195,143 @@ void printJson(const RenderCommandOptions& o, const RenderReport& report) {
     std::cout << j.dump(2) << "\n";
 }
 
+// --- frame sequences (--frames N) ---
+
+bool framePlan(const RenderCommandOptions& o, FramePlan& p) {
+    p.frames = o.frames;
+    p.cyclic = o.cyclic;
+    p.first = 1;
+    p.last = o.frames;
+    std::string error;
+    if (!o.clockRange.empty()) {
+        const auto range = parseClockRange(o.clockRange, error);
+        if (!range) {
+            std::cerr << "pcsg render: error: " << error << "\n";
+            return false;
+        }
+        std::tie(p.clockFrom, p.clockTo) = *range;
+    }
+    if (!o.subset.empty()) {
+        const auto subset = parseSubset(o.subset, o.frames, error);
+        if (!subset) {
+            std::cerr << "pcsg render: error: " << error << "\n";
+            return false;
+        }
+        std::tie(p.first, p.last) = *subset;
+    }
+    return true;
+}
+
+// What one frame of a sequence computed and wrote.
+struct FrameFigures {
+    int frame = 1;
+    double clock = 0;
+    std::string output;
+    tracer::RenderResult result;  // its pixels released once written
+    double imageWriteSeconds = 0;
+    std::optional<uint64_t> primitives;
+};
+
+// Sets frame f's time, renders it and writes its file, as a still at that clock would be.
+int renderFrame(const RenderCommandOptions& o, const FramePlan& plan, int f, Graph& g,
+                const std::string& imageHelper, FrameFigures& out) {
+    out.frame = f;
+    out.clock = frameClock(plan, f);
+    const std::string note =
+        fmt::format("\n  at frame {} of {}, clock {}", f, plan.frames, out.clock);
+    try {
+        setTime(g, Time{out.clock, f});
+    } catch (const RuntimeError& e) {
+        std::cerr << e.format(g) << note << "\n";
+        return 1;
+    }
+    RenderCommandOptions fo = o;
+    fo.output = frameFileName(o.output, f, plan.frames);
+    RenderReport report;
+    if (const int status = countAndRender(g, fo, report, note)) return status;
+    if (const std::string error = writeOutput(fo, imageHelper, report); !error.empty()) {
+        std::cerr << "pcsg render: " << error << note << "\n";
+        return 2;
+    }
+    report.result.rgb = {};
+    out.output = fo.output;
+    out.result = std::move(report.result);
+    out.imageWriteSeconds = report.imageWriteSeconds;
+    if (report.count.complete) out.primitives = report.count.primitives;
+    return 0;
+}
+
+nlohmann::json frameJson(const FrameFigures& f) {
+    nlohmann::json j = {{"frame", f.frame},
+                        {"clock", f.clock},
+                        {"output", f.output},
+                        {"rays", f.result.rays},
+                        {"seconds", f.result.seconds},
+                        {"bounds_seconds", f.result.boundsSeconds},
+                        {"node_visits", f.result.nodeVisits},
+                        {"image_write_seconds", f.imageWriteSeconds}};
+    if (f.primitives) j["primitive_equivalence"] = *f.primitives;
+    return j;
+}
+
+// The figures of the whole sequence: per frame, and the totals.
+void printFrames(const RenderCommandOptions& o, const FramePlan& plan, const Graph& g,
+                 const CompiledScene& compiled, const std::vector<FrameFigures>& done) {
+    Stats s;
+    s.scene = o.scene;
+    s.width = static_cast<uint32_t>(o.width);
+    s.height = static_cast<uint32_t>(o.height);
+    s.graphBytes = g.graphBytes();
+    s.parseSeconds = compiled.seconds;
+    uint64_t rays = 0;
+    double seconds = 0, writeSeconds = 0;
+    for (const FrameFigures& f : done) {
+        rays += f.result.rays;
+        seconds += f.result.seconds;
+        writeSeconds += f.imageWriteSeconds;
+    }
+    s.rays = rays;
+    s.seconds = seconds;
+    s.raysPerSecond = seconds > 0 ? rays / seconds : 0.0;
+    s.peakRssBytes = wholeCommandPeakRssBytes();
+    if (o.json) {
+        nlohmann::json j = s.toJson();
+        j["frames"] = nlohmann::json::array();
+        for (const FrameFigures& f : done) j["frames"].push_back(frameJson(f));
+        j["totals"] = {{"frames", done.size()},
+                       {"rays", rays},
+                       {"seconds", seconds},
+                       {"image_write_seconds", writeSeconds},
+                       {"frames_in_sequence", plan.frames},
+                       {"cyclic", plan.cyclic}};
+        j["graph_nodes"] = g.nodes.size();
+        std::cout << j.dump(2) << "\n";
+        return;
+    }
+    std::cout << fmt::format("{}: wrote {} frames ({} to {} of {}) in {:.3f} s\n", o.scene,
+                             done.size(), plan.first, plan.last, plan.frames, seconds);
+    s.print(std::cout);
+    std::cout << fmt::format("{:<24}{:.3f} s\n", "image write time", writeSeconds);
+}
+
+int runFrames(const RenderCommandOptions& o, const FramePlan& plan, CompiledScene& compiled,
+              const std::string& imageHelper) {
+    Graph& g = *compiled.graph;
+    std::vector<FrameFigures> done;
+    for (int f = plan.first; f <= plan.last; ++f) {
+        FrameFigures figures;
+        if (const int status = renderFrame(o, plan, f, g, imageHelper, figures)) return status;
+        if (!o.json)
+            std::cout << fmt::format("frame {} of {} (clock {}): wrote {} in {:.3f} s, {} rays\n",
+                                     f, plan.frames, figures.clock, figures.output,
+                                     figures.result.seconds, figures.result.rays)
+                      << std::flush;
+        done.push_back(std::move(figures));
+    }
+    printFrames(o, plan, g, compiled, done);
+    return 0;
+}
+
 void printText(const RenderCommandOptions& o, const RenderReport& report) {
     const tracer::RenderResult& result = report.result;
     std::cout << fmt::format("{}: wrote {} ({}x{}) in {:.3f} s\n", o.scene, o.output, o.width,
@@ -205,7 +355,12 @@ void printText(const RenderCommandOptions& o, const RenderReport& report) {
                                  report.imageWriteSeconds);
 }
 
+int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
+             const std::string& imageHelper);
+
 int runRender(const RenderCommandOptions& o) {
+    FramePlan plan;
+    if (o.frames > 0 && !framePlan(o, plan)) return 2;
     // Before the render: without a writer, the render would be for nothing.
     std::string imageHelper;
     if (imageFormatOf(o.output) != ImageFormat::png) {
@@ -219,9 +374,15 @@ int runRender(const RenderCommandOptions& o) {
     }
     CompiledScene compiled = compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
+    if (o.frames > 0) return runFrames(o, plan, compiled, imageHelper);
+    return runStill(o, compiled, imageHelper);
+}
+
+// One image at --clock (clock 0 without it), frame 1.
+int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
+             const std::string& imageHelper) {
     Graph& g = *compiled.graph;
     if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
-
     RenderReport report;
     if (const int status = countAndRender(g, o, report)) return status;
     if (const std::string error = writeOutput(o, imageHelper, report); !error.empty()) {
@@ -255,6 +416,26 @@ const CLI::Validator kImageOutput(
         return fmt::format("cannot write '{}': unknown image type ({})", path, kImageTypesHint);
     },
     "IMAGE");
+
+// --clock, or --frames and what goes with it (docs/language.md section 11).
+void addTimeOptions(CLI::App* cmd, RenderCommandOptions& o) {
+    auto* clock = addClockOption(cmd, o.clock);
+    auto* frames =
+        cmd->add_option("--frames", o.frames,
+                        "Render N frames of an animation, named like POV-Ray's: the frame "
+                        "number zero-padded to the width of N before the extension (OUT01.png "
+                        "... OUT24.png); frame f has clock A + (f-1)(B-A)/(N-1)")
+            ->check(CLI::Range(1, 1000000));
+    clock->excludes(frames);
+    cmd->add_option("--clock-range", o.clockRange,
+                    "A,B: the clocks of the first and last frame (default 0,1)")
+        ->needs(frames);
+    cmd->add_flag("--cyclic", o.cyclic,
+                  "A cyclic animation (POV-Ray's +KC): the clock steps by (B-A)/N, so the last "
+                  "frame is not B")
+        ->needs(frames);
+    cmd->add_option("--subset", o.subset, "F,L: render only frames F to L of the N")->needs(frames);
+}
 
 }  // namespace
 
@@ -295,7 +476,7 @@ void addRenderCommand(CLI::App& app, int& status) {
                     "same whatever the count")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    addClockOption(cmd, o->clock);
+    addTimeOptions(cmd, *o);
     cmd->add_flag("--json", o->json, "Print the figures as JSON");
     cmd->add_flag("--no-bounds", o->noBounds,
                   "Do not cull with hyper-bounding boxes (slow; for checking that culling never "

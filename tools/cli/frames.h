@@ -1,0 +1,34 @@
+// Frame sequences of `pcsg render --frames N` (docs/language.md section 11), numbered and
+// named as POV-Ray numbers and names them (+KFI1 +KFF<N> +KI<a> +KF<b> [+KC]).
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace pcsg::tools {
+
+struct FramePlan {
+    int frames = 1;                     // N
+    double clockFrom = 0, clockTo = 1;  // a, b
+    bool cyclic = false;                // +KC: the step is (b-a)/N, so frame N+1 would be a again
+    int first = 1, last = 1;            // --subset: the frames rendered, 1 <= first <= last <= N
+};
+
+// The clock of frame f (1-based) of the plan: a + (f-1)(b-a)/(N-1), or (b-a)/N steps when
+// cyclic; a when N is 1 (computed as std::lerp, so the last frame of a non-cyclic plan is b
+// exactly).
+double frameClock(const FramePlan& plan, int frame);
+
+// The file of frame f of N: the frame number, zero-padded to the width of N, before the
+// extension ("out.png", 24 frames: "out01.png" ... "out24.png"; 3 frames: "out1.png").
+std::string frameFileName(const std::string& output, int frame, int frames);
+
+// "A,B": two finite numbers, A <= B. Nothing, with `error` set, otherwise.
+std::optional<std::pair<double, double>> parseClockRange(const std::string& text,
+                                                         std::string& error);
+
+// "F,L": whole numbers, 1 <= F <= L <= frames. Nothing, with `error` set, otherwise.
+std::optional<std::pair<int, int>> parseSubset(const std::string& text, int frames,
+                                               std::string& error);
+
+}  // namespace pcsg::tools

@@ -1,0 +1,154 @@
+// Frame sequences (docs/language.md section 11): POV-Ray's clocks and file names, the
+// errors of a wrong command line, a run-time error at frame k, and a frame rendered alone
+// with --clock pixel for pixel the same frame as inside its sequence.
+#include "frames.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli_test_util.h"
+
+namespace pcsg::tools {
+namespace {
+
+using testing::filesIn;
+using testing::pcsg;
+using testing::readFile;
+using testing::TempDir;
+
+TEST(Frames, ClocksArePovRays) {
+    FramePlan p;
+    p.frames = 5;
+    EXPECT_EQ(frameClock(p, 1), 0);
+    EXPECT_EQ(frameClock(p, 3), 0.5);
+    EXPECT_EQ(frameClock(p, 5), 1);
+    p.cyclic = true;
+    EXPECT_EQ(frameClock(p, 2), 0.2);
+    EXPECT_EQ(frameClock(p, 5), 0.8);
+    p = FramePlan{.frames = 3, .clockFrom = 2, .clockTo = 4};
+    EXPECT_EQ(frameClock(p, 2), 3);
+    p.frames = 1;
+    EXPECT_EQ(frameClock(p, 1), 2);  // one frame: clock A
+}
+
+TEST(Frames, NamesArePovRays) {
+    EXPECT_EQ(frameFileName("out.png", 1, 24), "out01.png");
+    EXPECT_EQ(frameFileName("out.png", 24, 24), "out24.png");
+    EXPECT_EQ(frameFileName("out.png", 3, 3), "out3.png");
+    EXPECT_EQ(frameFileName("dir/a.b/growth.exr", 7, 100), "dir/a.b/growth007.exr");
+    EXPECT_EQ(frameFileName("x.tif", 10, 10), "x10.tif");
+}
+
+TEST(Frames, RangesAndSubsetsAreChecked) {
+    std::string error;
+    EXPECT_EQ(parseClockRange("0.5,2", error), (std::pair{0.5, 2.0}));
+    EXPECT_EQ(parseClockRange("1,1", error), (std::pair{1.0, 1.0}));
+    for (const char* bad : {"1,0", "0,inf", "nan,1", "1", "1,2,3", ",1", "a,b"}) {
+        EXPECT_FALSE(parseClockRange(bad, error)) << bad;
+        EXPECT_NE(error.find("--clock-range"), std::string::npos);
+    }
+    EXPECT_NE((parseClockRange("1,0", error), error).find("reversed"), std::string::npos);
+    EXPECT_EQ(parseSubset("2,3", 5, error), (std::pair{2, 3}));
+    for (const char* bad : {"0,2", "3,2", "2,6", "1.5,2", "2"})
+        EXPECT_FALSE(parseSubset(bad, 5, error)) << bad;
+}
+
+const char* kMoving =
+    "camera { location <4*cos(clock*360 - 90), 4*sin(clock*360 - 90), 2>  look_at <0,0,0> }\n"
+    "move(clock * 2 - 1, 0, 0) uscale(0.5) sphere ∪ {n = 3} S\n"
+    "S if(n > 0 && clock > 0.3, 2, 1)\n"
+    "1: S -> move(0, 1, 0) rotz(clock * 90) uscale(0.4) cube\n"
+    "2: S -> {n = n - 1} (move(0, 1, 0) uscale(0.3) cube ∪ move(0, 0, 0.8) uscale(0.7) S)\n";
+
+std::vector<std::string> small(std::vector<std::string> args) {
+    for (const char* a : {"--width", "40", "--height", "30", "--threads", "2"}) args.push_back(a);
+    return args;
+}
+
+TEST(Frames, ASequenceIsWrittenWithPovRaysNames) {
+    TempDir dir;
+    const std::string scene = dir.write("m.pcsg", kMoving);
+    const ChildResult r = pcsg(small({"render", scene, "-o", dir.file("a.png"), "--frames", "10"}));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::vector<std::string> want = {"a01.png", "a02.png", "a03.png", "a04.png",
+                                     "a05.png", "a06.png", "a07.png", "a08.png",
+                                     "a09.png", "a10.png", "m.pcsg"};
+    EXPECT_EQ(filesIn(dir.path()), want);
+    EXPECT_NE(readFile(dir.file("a01.png")), readFile(dir.file("a10.png")));
+}
+
+TEST(Frames, AFrameAloneIsTheFrameInTheSequence) {
+    TempDir dir;
+    const std::string scene = dir.write("m.pcsg", kMoving);
+    const ChildResult r = pcsg(small({"render", scene, "-o", dir.file("s.png"), "--frames", "7",
+                                      "--clock-range", "0.1,0.9", "--json"}));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["frames"].size(), 7u);
+    EXPECT_EQ(j["totals"]["frames"], 7);
+    uint64_t rays = 0;
+    for (const auto& f : j["frames"]) rays += f["rays"].get<uint64_t>();
+    EXPECT_EQ(j["totals"]["rays"].get<uint64_t>(), rays);
+    for (const auto& f : j["frames"]) {
+        const std::string clock = nlohmann::json(f["clock"].get<double>()).dump();
+        const std::string alone = dir.file("alone.png");
+        const ChildResult a = pcsg(small({"render", scene, "-o", alone, "--clock", clock}));
+        ASSERT_EQ(a.exitCode, 0) << a.err;
+        EXPECT_EQ(readFile(alone), readFile(f["output"].get<std::string>()))
+            << "frame " << f["frame"] << " at clock " << clock;
+    }
+    EXPECT_EQ(j["frames"][6]["clock"].get<double>(), 0.9);
+}
+
+TEST(Frames, SubsetAndCyclicPickTheirFrames) {
+    TempDir dir;
+    const std::string scene = dir.write("m.pcsg", kMoving);
+    const ChildResult r = pcsg(small({"render", scene, "-o", dir.file("c.png"), "--frames", "4",
+                                      "--cyclic", "--subset", "3,4", "--json"}));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["frames"].size(), 2u);
+    EXPECT_EQ(j["frames"][0]["clock"].get<double>(), 0.5);
+    EXPECT_EQ(j["frames"][1]["clock"].get<double>(), 0.75);
+    EXPECT_EQ(filesIn(dir.path()), (std::vector<std::string>{"c3.png", "c4.png", "m.pcsg"}));
+}
+
+TEST(Frames, AWrongCommandLineExitsTwo) {
+    TempDir dir;
+    const std::string scene = dir.write("m.pcsg", kMoving);
+    const std::string out = dir.file("e.png");
+    const std::vector<std::vector<std::string>> cases = {
+        {"--frames", "0"},
+        {"--frames", "3", "--clock-range", "1,0"},
+        {"--frames", "3", "--clock-range", "0,nan"},
+        {"--frames", "3", "--clock", "0.5"},
+        {"--clock-range", "0,1"},
+        {"--frames", "3", "--subset", "2,4"},
+    };
+    for (const auto& extra : cases) {
+        std::vector<std::string> args = {"render", scene, "-o", out};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const ChildResult r = pcsg(args);
+        EXPECT_EQ(r.exitCode, 2) << extra[0] << " " << extra[1] << "\n" << r.err;
+        EXPECT_FALSE(r.err.empty());
+    }
+    EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"m.pcsg"});
+}
+
+TEST(Frames, ARunTimeErrorAtFrameKNamesItAndKeepsTheFramesBefore) {
+    TempDir dir;
+    // Rule 3 of two from clock 0.6 on: frames 1 and 2 (clock 0, 0.5) render, frame 3 fails.
+    const std::string scene =
+        dir.write("bad.pcsg", "S\nS if(clock < 0.6, 1, 3)\n1: S -> sphere\n2: S -> cube\n");
+    const ChildResult r = pcsg(small({"render", scene, "-o", dir.file("b.png"), "--frames", "3"}));
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("the selection function of module S"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("frame 3 of 3, clock 1"), std::string::npos) << r.err;
+    EXPECT_EQ(filesIn(dir.path()), (std::vector<std::string>{"b1.png", "b2.png", "bad.pcsg"}));
+}
+
+}  // namespace
+}  // namespace pcsg::tools
