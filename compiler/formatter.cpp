@@ -1,0 +1,423 @@
+// pcsg fmt: the canonical layout of a scene. See formatter.h.
+#include "formatter.h"
+
+#include <algorithm>
+#include <initializer_list>
+#include <vector>
+
+#include "ast.h"
+#include "compiler.h"
+#include "lexer.h"
+#include "parser.h"
+
+namespace pcsg {
+
+namespace {
+
+constexpr char kBreak = '\x01';  // a place after `∪ ` where a long statement may break
+
+// The precedence level of a binary operator (parser.cpp's table; `=` of a notation-B
+// condition is stored as Eq).
+int level(Tok k) {
+    switch (k) {
+        case Tok::OrOr:
+            return 1;
+        case Tok::AndAnd:
+            return 2;
+        case Tok::Eq:
+        case Tok::Ne:
+            return 3;
+        case Tok::Lt:
+        case Tok::Le:
+        case Tok::Gt:
+        case Tok::Ge:
+            return 4;
+        case Tok::Plus:
+        case Tok::Minus:
+            return 5;
+        default:
+            return 6;
+    }
+}
+constexpr int kAtom = 99;
+constexpr int kAdditive = 5;
+
+// Concatenation without `"literal" + std::string` (GCC 12 warns -Wrestrict on it).
+std::string cat(std::initializer_list<std::string_view> parts) {
+    std::string s;
+    size_t n = 0;
+    for (std::string_view p : parts) n += p.size();
+    s.reserve(n);
+    for (std::string_view p : parts) s.append(p);
+    return s;
+}
+
+std::string paren(std::string_view s) {
+    return cat({"(", s, ")"});
+}
+
+// Display width: UTF-8 code points.
+size_t width(std::string_view s) {
+    size_t w = 0;
+    for (unsigned char c : s) w += (c & 0xC0) != 0x80;
+    return w;
+}
+
+class Printer {
+  public:
+    Printer(const Source& src, const std::vector<Token>& tokens, const Ast& ast)
+        : src_(src), t_(tokens), ast_(ast) {}
+
+    // One statement, possibly over several lines, without a final newline.
+    std::string statement(const Stmt& s) const {
+        if (s.kind == StmtKind::Directive) return directive(s);
+        return fill(flatStatement(s));
+    }
+
+  private:
+    std::string text(uint32_t tok) const { return std::string(spelling(src_, t_[tok])); }
+
+    // --- arithmetic ---
+
+    int exprLevel(uint32_t e) const {
+        const ExNode& n = ast_.exprs[e];
+        return n.kind == ExKind::Chain ? level(ast_.chainItems[n.first].op) : kAtom;
+    }
+
+    std::string list(uint32_t first, uint32_t count) const {
+        std::string s;
+        for (uint32_t k = 0; k < count; ++k) {
+            if (k > 0) s += ", ";
+            s += expr(ast_.lists[first + k]);
+        }
+        return s;
+    }
+
+    std::string expr(uint32_t e) const {
+        const ExNode& n = ast_.exprs[e];
+        switch (n.kind) {
+            case ExKind::Number:
+            case ExKind::Name:
+            case ExKind::Time:
+                return text(n.tok);
+            case ExKind::Call:
+                return text(n.tok) + "(" + list(n.first, n.count) + ")";
+            case ExKind::Unary: {
+                const ExKind k = ast_.exprs[n.a].kind;
+                const std::string a = expr(n.a);
+                return text(n.tok) + (k == ExKind::Chain || k == ExKind::Unary ? paren(a) : a);
+            }
+            case ExKind::Power: {
+                const ExKind k = ast_.exprs[n.a].kind;
+                const bool primary = k != ExKind::Chain && k != ExKind::Unary && k != ExKind::Power;
+                const std::string b = expr(n.b);
+                return (primary ? expr(n.a) : paren(expr(n.a))) + "^" +
+                       (ast_.exprs[n.b].kind == ExKind::Chain ? paren(b) : b);
+            }
+            case ExKind::Chain:
+                break;
+        }
+        // A chain keeps its grouping: an operand of its own level or looser was in
+        // parentheses (the left one too, or it would join this chain).
+        const int own = exprLevel(e);
+        std::string s = exprLevel(n.a) <= own ? paren(expr(n.a)) : expr(n.a);
+        for (uint32_t k = 0; k < n.count; ++k) {
+            const ChainItem& item = ast_.chainItems[n.first + k];
+            const std::string x = expr(item.operand);
+            s += cat({" ", text(item.tok), " ", exprLevel(item.operand) <= own ? paren(x) : x});
+        }
+        return s;
+    }
+
+    // --- CSG ---
+
+    std::string operatorCsg(const CsgNode& n) const {
+        const char* sep = n.csgOp == CsgOp::Union          ? " ∪ \x01"
+                          : n.csgOp == CsgOp::Intersection ? " ∩ "
+                                                           : " \\ ";
+        std::string s;
+        for (uint32_t k = 0; k < n.count; ++k) {
+            const uint32_t c = ast_.lists[n.first + k];
+            const CsgNode& o = ast_.csg[c];
+            bool wrap = false;
+            if (o.kind == CsgKind::Operator) {
+                if (n.csgOp == CsgOp::Union)
+                    wrap = o.csgOp == CsgOp::Union;
+                else
+                    wrap = k > 0 || o.csgOp == CsgOp::Union || o.csgOp == n.csgOp;
+            }
+            if (k > 0) s += sep;
+            s += wrap ? paren(csg(c)) : csg(c);
+        }
+        return s;
+    }
+
+    // The operand of a prefix: an operator needs its parentheses back.
+    std::string child(uint32_t c) const {
+        const std::string s = csg(c);
+        return ast_.csg[c].kind == CsgKind::Operator ? paren(s) : s;
+    }
+
+    std::string calc(const CsgNode& n) const {
+        std::string s = "{";
+        for (uint32_t k = 0; k < n.count; ++k) {
+            const Assign& a = ast_.assigns[n.first + k];
+            if (k > 0) s += "; ";
+            s += text(a.nameTok) + " = " + expr(a.value);
+        }
+        return s + "} " + child(n.child);
+    }
+
+    std::string csg(uint32_t c) const {
+        const CsgNode& n = ast_.csg[c];
+        switch (n.kind) {
+            case CsgKind::Operator:
+                return operatorCsg(n);
+            case CsgKind::Transform: {
+                const bool flip = n.op == TransformOp::FlipYZ || n.op == TransformOp::FlipXZ ||
+                                  n.op == TransformOp::FlipXY;
+                return cat(
+                    {text(n.tok), flip ? "" : paren(list(n.first, n.count)), " ", child(n.child)});
+            }
+            case CsgKind::Calc:
+                return calc(n);
+            case CsgKind::Paint:
+                return cat({"paint(", text(n.nameTok), ") ", child(n.child)});
+            case CsgKind::Primitive: {
+                const bool args = n.tok + 1 < t_.size() && t_[n.tok + 1].kind == Tok::LParen;
+                return cat({text(n.tok), args ? paren(list(n.first, n.count)) : ""});
+            }
+            case CsgKind::Name:
+                return text(n.nameTok);
+            case CsgKind::Call:
+                return text(n.nameTok) + "(" + list(n.first, n.count) + ")";
+        }
+        return {};
+    }
+
+    // --- statements ---
+
+    std::string flatStatement(const Stmt& s) const {
+        switch (s.kind) {
+            case StmtKind::RuleA:
+                return text(s.labelTok) + ": " + text(s.nameTok) + " -> " + csg(s.body);
+            case StmtKind::RuleB: {
+                std::string h = text(s.labelTok) + ": " + text(s.nameTok);
+                if (s.hasFormals) {
+                    h += "(";
+                    for (uint32_t k = 0; k < s.count; ++k)
+                        h += cat({k > 0 ? ", " : "", text(ast_.lists[s.first + k])});
+                    h += ")";
+                }
+                if (s.expr != kNoNode) h += cat({" : ", expr(s.expr)});
+                return h + " -> " + csg(s.body);
+            }
+            case StmtKind::AxiomB:
+                return text(s.labelTok) + ": " + csg(s.body);
+            case StmtKind::Definition:
+                return text(s.nameTok) + " = " + csg(s.body);
+            case StmtKind::Module:
+                return text(s.nameTok) + " " + expr(s.expr);
+            default:
+                return csg(s.body);
+        }
+    }
+
+    // Breaks a flat statement at its break marks, filling each line up to the width.
+    static std::string fill(const std::string& flat) {
+        std::vector<std::string> chunks;
+        size_t start = 0;
+        for (size_t i = 0; i <= flat.size(); ++i) {
+            if (i == flat.size() || flat[i] == kBreak) {
+                chunks.push_back(flat.substr(start, i - start));
+                start = i + 1;
+            }
+        }
+        std::string out, line = chunks[0];
+        for (size_t k = 1; k < chunks.size(); ++k) {
+            std::string next = line + chunks[k];
+            while (!next.empty() && next.back() == ' ') next.pop_back();
+            if (width(next) > kFormatWidth) {
+                while (!line.empty() && line.back() == ' ') line.pop_back();
+                out += line + "\n";
+                line = std::string(kFormatIndent, ' ') + chunks[k];
+            } else {
+                line += chunks[k];
+            }
+        }
+        return out + line;
+    }
+
+    std::string vector(const DirectiveItem& item) const {
+        std::string s = "<";
+        for (int k = 0; k < 3; ++k) {
+            if (k > 0) s += ", ";
+            const std::string x = expr(item.e[k]);
+            s += exprLevel(item.e[k]) < kAdditive ? paren(x) : x;
+        }
+        return s + ">";
+    }
+
+    // `camera { location <4, -6, 3>  look_at <0, 0, 0.5> }` on one line when it fits,
+    // else one item per line.
+    std::string directive(const Stmt& s) const {
+        std::string head = text(s.tok);
+        if (s.directive == Kw::Background) return head + " " + vector(ast_.items[s.first]);
+        if (s.directive == Kw::Material) head += cat({" ", text(s.nameTok)});
+        std::vector<std::string> items;
+        for (uint32_t k = 0; k < s.count; ++k) {
+            const DirectiveItem& item = ast_.items[s.first + k];
+            items.push_back(text(item.nameTok) + " " +
+                            (item.vector ? vector(item) : expr(item.e[0])));
+        }
+        if (items.empty()) return head + " {}";
+        std::string one = head + " {";
+        for (size_t k = 0; k < items.size(); ++k) one += cat({k > 0 ? "  " : " ", items[k]});
+        one += " }";
+        if (width(one) <= kFormatWidth) return one;
+        std::string many = head + " {\n";
+        for (const std::string& item : items) many += std::string(kFormatIndent, ' ') + item + "\n";
+        return many + "}";
+    }
+
+    const Source& src_;
+    const std::vector<Token>& t_;
+    const Ast& ast_;
+};
+
+struct Span {
+    uint32_t begin = 0, end = 0;
+};
+
+// The comments of a text, in order, and the offset of a `#` outside them (or none).
+struct Scan {
+    std::vector<Span> comments;
+    std::optional<uint32_t> hash;
+};
+
+Scan scanComments(std::string_view s) {
+    Scan scan;
+    size_t i = s.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
+    while (i < s.size()) {
+        if (s[i] == '/' && i + 1 < s.size() && (s[i + 1] == '/' || s[i + 1] == '*')) {
+            const bool line = s[i + 1] == '/';
+            size_t end = line ? s.find('\n', i) : s.find("*/", i + 2);
+            end = end == std::string_view::npos ? s.size() : end + (line ? 0 : 2);
+            scan.comments.push_back({static_cast<uint32_t>(i), static_cast<uint32_t>(end)});
+            i = end;
+            continue;
+        }
+        if (s[i] == '#' && !scan.hash) scan.hash = static_cast<uint32_t>(i);
+        ++i;
+    }
+    return scan;
+}
+
+// Each statement's text: its first token to its last.
+std::vector<Span> statementSpans(const Ast& ast, const std::vector<Token>& t) {
+    std::vector<Span> spans;
+    for (const Stmt& s : ast.stmts) {
+        size_t j = s.tok;
+        while (t[j].kind != Tok::End &&
+               !((t[j].kind == Tok::Newline || t[j].kind == Tok::Semicolon) &&
+                 (t[j].flags & kTopLevel)))
+            ++j;
+        const Token& last = t[j - 1];
+        spans.push_back({t[s.tok].offset, last.offset + last.length});
+    }
+    return spans;
+}
+
+// Where each comment goes: inside statement k (moved before it), after statement k on
+// its last line, or on lines of its own (before the next statement).
+struct Placement {
+    std::vector<std::vector<Span>> inner, trailing;
+    std::vector<Span> standalone;
+};
+
+Placement placeComments(std::string_view text, const std::vector<Span>& stmts,
+                        const std::vector<Span>& comments) {
+    Placement p;
+    p.inner.resize(stmts.size());
+    p.trailing.resize(stmts.size());
+    size_t si = 0;
+    for (const Span& c : comments) {
+        while (si < stmts.size() && stmts[si].end <= c.begin) ++si;
+        if (si < stmts.size() && stmts[si].begin <= c.begin) {
+            p.inner[si].push_back(c);
+        } else if (si > 0 &&
+                   text.substr(stmts[si - 1].end, c.begin - stmts[si - 1].end).find('\n') ==
+                       std::string_view::npos) {
+            p.trailing[si - 1].push_back(c);
+        } else {
+            p.standalone.push_back(c);
+        }
+    }
+    return p;
+}
+
+class Emitter {
+  public:
+    explicit Emitter(std::string_view text) : text_(text) {}
+
+    // Starts an item at `begin`: one blank line if the text had any since the last item.
+    void start(uint32_t begin) {
+        const auto gap = text_.substr(last_, begin > last_ ? begin - last_ : 0);
+        if (!out_.empty() && std::count(gap.begin(), gap.end(), '\n') >= 2) out_ += "\n";
+    }
+    void comment(Span c) {
+        start(c.begin);
+        line(c);
+        last_ = c.end;
+    }
+    void line(Span c) { out_ += std::string(text_.substr(c.begin, c.end - c.begin)) + "\n"; }
+    void statement(Span s, const std::string& body, const std::vector<Span>& inner,
+                   const std::vector<Span>& trailing) {
+        start(s.begin);
+        for (const Span& c : inner) line(c);
+        out_ += body;
+        last_ = s.end;
+        for (const Span& c : trailing) {
+            out_ += cat({" ", text_.substr(c.begin, c.end - c.begin)});
+            last_ = c.end;
+        }
+        out_ += "\n";
+    }
+    std::string take() { return std::move(out_); }
+
+  private:
+    std::string_view text_;
+    std::string out_;
+    uint32_t last_ = 0;
+};
+
+}  // namespace
+
+std::optional<std::string> formatScene(std::string_view fileName, std::string_view text,
+                                       Diagnostics& diags) {
+    if (!compileSource(fileName, text, diags)) return std::nullopt;
+    const uint32_t file = static_cast<uint32_t>(diags.fileNames().size() - 1);
+    const Source src(text, file);
+    const Scan scan = scanComments(text);
+    if (scan.hash) {
+        diags.error(src.loc(*scan.hash), "pcsg fmt does not format files with #define yet");
+        return std::nullopt;
+    }
+    Diagnostics quiet;  // the file compiled: lexing and parsing it again report nothing
+    const TokenStream tokens = lex(src, quiet);
+    const Ast ast = parse(src, tokens, quiet);
+    const Printer printer(src, tokens.tokens, ast);
+    const std::vector<Span> spans = statementSpans(ast, tokens.tokens);
+    const Placement place = placeComments(text, spans, scan.comments);
+    Emitter out(text);
+    size_t ci = 0;
+    for (size_t k = 0; k < ast.stmts.size(); ++k) {
+        while (ci < place.standalone.size() && place.standalone[ci].begin < spans[k].begin)
+            out.comment(place.standalone[ci++]);
+        out.statement(spans[k], printer.statement(ast.stmts[k]), place.inner[k], place.trailing[k]);
+    }
+    while (ci < place.standalone.size()) out.comment(place.standalone[ci++]);
+    return out.take();
+}
+
+}  // namespace pcsg

@@ -1,0 +1,34 @@
+// pcsg fmt: prints a scene in one canonical layout from its syntax tree (ast.h).
+//
+// Statements keep their order, one per line; operators, C-nodes and directives get one
+// spacing; numbers, names and keywords keep their source text (so no value changes);
+// `|` `&` `→` become `∪` `∩` `->`; a statement wider than kFormatWidth columns is broken
+// after `∪` with continuation lines indented by kFormatIndent spaces. Parentheses are
+// printed where the grammar needs them to give the same syntax tree back.
+//
+// Comments (which the lexer drops) are found by position in the text and kept: a comment
+// before a statement stays on its own line(s) before it, one after a statement's end on
+// the same line stays there, and one inside a statement's text moves to a line of its
+// own just before that statement. One blank line is kept where the text had one or more.
+//
+// A file that uses #define is refused (the lexer expands macros before the parser, so
+// the tree no longer shows them): "pcsg fmt does not format files with #define yet".
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "diagnostics.h"
+
+namespace pcsg {
+
+inline constexpr size_t kFormatWidth = 100;
+inline constexpr size_t kFormatIndent = 4;
+
+// The canonical text of a scene, or nothing with the errors in `diags` when the scene
+// does not compile (or uses #define). `text` must outlive `diags`.
+std::optional<std::string> formatScene(std::string_view fileName, std::string_view text,
+                                       Diagnostics& diags);
+
+}  // namespace pcsg
