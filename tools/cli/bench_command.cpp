@@ -2,8 +2,14 @@
 // one run on one machine, at the same size and sampling, and compare time and memory.
 // Ratios measured side by side are what the targets of docs/benchmarks.md are about;
 // absolute times on a shared machine are not.
+//
+// When pcsg-embree (tools/bench/embree_bench.cpp, built when Embree 3 is found) is beside
+// pcsg, each triangle-only scene is also traced by Embree on its expanded mesh, the
+// yardstick of the native renderer: its build and trace times, rays per second and peak
+// RSS fill four more columns, and three more targets compare the two.
 #include <fmt/format.h>
 #include <sys/utsname.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -35,6 +41,15 @@ struct BenchOptions {
     uint64_t maxNodes = 10'000'000;
 };
 
+// What pcsg-embree measured on a triangle-only scene: its own build and trace times and
+// rays per second, and the whole command's wall time and peak RSS (wait4).
+struct EmbreeRun {
+    uint64_t triangles = 0;
+    double buildSeconds = 0, traceSeconds = 0, raysPerSecond = 0;
+    double seconds = 0;  // the whole command: compiling, expanding, building and tracing
+    uint64_t peakRss = 0;
+};
+
 struct BenchRow {
     std::string scene;
     bool nativeOk = false, povOk = false;
@@ -45,6 +60,8 @@ struct BenchRow {
     uint64_t nativeRss = 0, povRss = 0;
     std::optional<double> raysPerSecond;
     std::optional<uint64_t> primitives;
+    double nativeCommandSeconds = 0;  // the whole `pcsg render` command's wall time
+    std::optional<EmbreeRun> embree;  // a triangle-only scene that pcsg-embree traced
 };
 
 // The scenes of the targets: the Sierpinski tetrahedron at growing order and the
@@ -81,7 +98,40 @@ std::string today() {
     return buf;
 }
 
-BenchRow benchScene(const std::string& scene, const BenchOptions& o, const fs::path& work) {
+// pcsg-embree beside this executable, or nothing (then bench has no Embree columns).
+std::optional<std::string> findEmbree() {
+    const fs::path self = selfExecutable();
+    if (!self.has_parent_path()) return std::nullopt;
+    const fs::path beside = self.parent_path() / "pcsg-embree";
+    if (access(beside.c_str(), X_OK) != 0) return std::nullopt;
+    return beside.string();
+}
+
+// Embree on the scene's expanded mesh at the bench's size and thread count: one camera ray
+// per pixel centre and a shadow ray per hit and light. Nothing when the scene is not
+// triangle-only (exit status 2) or Embree could not trace it (over --max-nodes, say).
+std::optional<EmbreeRun> runEmbree(const std::string& embree, const std::string& scene,
+                                   const BenchOptions& o) {
+    const int threads = o.threads > 0 ? o.threads : int(std::thread::hardware_concurrency());
+    const ChildResult c =
+        runChild({embree, scene, "--json", "--width", std::to_string(o.width), "--height",
+                  std::to_string(o.height), "--threads", std::to_string(std::max(threads, 1)),
+                  "--max-nodes", std::to_string(o.maxNodes)});
+    if (c.exitCode != 0) return std::nullopt;
+    const auto j = nlohmann::json::parse(c.out, nullptr, false);
+    if (!j.is_object()) return std::nullopt;
+    EmbreeRun e;
+    e.triangles = j.value("triangles", uint64_t{0});
+    e.buildSeconds = j.value("build_seconds", 0.0);
+    e.traceSeconds = j.value("trace_seconds", 0.0);
+    e.raysPerSecond = j.value("rays_per_second", 0.0);
+    e.seconds = c.seconds;
+    e.peakRss = c.peakRssBytes;
+    return e;
+}
+
+BenchRow benchScene(const std::string& scene, const BenchOptions& o, const fs::path& work,
+                    const std::optional<std::string>& embree) {
     BenchRow row;
     row.scene = fs::path(scene).stem().string();
     std::vector<std::string> threads;
@@ -100,9 +150,11 @@ BenchRow benchScene(const std::string& scene, const BenchOptions& o, const fs::p
     row.nativeSeconds = jsonField<double>(native.json, "seconds").value_or(native.child.seconds);
     // The whole render command's peak, as wait4 reports it.
     row.nativeRss = native.child.peakRssBytes;
+    row.nativeCommandSeconds = native.child.seconds;
     row.raysPerSecond = jsonField<double>(native.json, "rays_per_second");
     row.primitives = jsonField<uint64_t>(native.json, "primitive_equivalence");
     if (o.nativeOnly) return row;
+    if (embree) row.embree = runEmbree(*embree, scene, o);
 
     const fs::path pov = work / (row.scene + ".pov");
     const RenderRun exported = exportPov(scene, pov.string(), o.width, o.height,
@@ -139,6 +191,52 @@ struct Target {
 
 // The whole `pcsg render` command's peak RSS at order 8, 640x480, +A0.3.
 constexpr uint64_t kOrder8RssLimit = 22'000'000;
+
+// The Sierpinski order in a bench scene's name (sierpinski_9: 9), or 0 for another scene.
+int sierpinskiOrder(const std::string& scene) {
+    const std::string prefix = "sierpinski_";
+    if (scene.rfind(prefix, 0) != 0) return 0;
+    try {
+        return std::stoi(scene.substr(prefix.size()));
+    } catch (const std::exception&) {
+        return 0;
+    }
+}
+
+// The yardstick targets against Embree on the expanded mesh, judged on the rows that
+// Embree traced: the native trace rate within 3x of Embree's and the native peak RSS at
+// most 1/20 of Embree's (Sierpinski order 8 and the terrain), and the whole native command
+// faster than Embree's whole command, its build included, from order 9 on.
+void addEmbreeTargets(const std::vector<BenchRow>& rows, std::vector<Target>& t) {
+    std::string ahead;
+    bool allAhead = true;
+    for (const BenchRow& r : rows) {
+        if (!r.nativeOk || !r.embree) continue;
+        const EmbreeRun& e = *r.embree;
+        if (r.scene == "sierpinski_8" || r.scene == "terrain") {
+            const double rate = r.raysPerSecond.value_or(0);
+            t.push_back({fmt::format("{} native trace rate within 3x of Embree's ({:.0f} against "
+                                     "{:.0f} rays/s: 1/{:.2f})",
+                                     r.scene, rate, e.raysPerSecond,
+                                     e.raysPerSecond / std::max(rate, 1e-9)),
+                         rate * 3 >= e.raysPerSecond});
+            const double rss = double(e.peakRss) / double(std::max<uint64_t>(r.nativeRss, 1));
+            t.push_back({fmt::format("{} native peak RSS at most 1/20 of Embree's ({} against {}: "
+                                     "1/{:.1f})",
+                                     r.scene, humanBytes(r.nativeRss), humanBytes(e.peakRss), rss),
+                         rss >= 20});
+        }
+        if (const int order = sierpinskiOrder(r.scene); order >= 9) {
+            ahead += fmt::format("{}order {}: {:.2f} s against {:.2f} s", ahead.empty() ? "" : "; ",
+                                 order, r.nativeCommandSeconds, e.seconds);
+            allAhead = allAhead && r.nativeCommandSeconds < e.seconds;
+        }
+    }
+    if (!ahead.empty())
+        t.push_back(
+            {"whole time (Embree's build included) ahead of Embree from order 9 on (" + ahead + ")",
+             allAhead});
+}
 
 // The performance targets (docs/benchmarks.md), judged from the rows that are there.
 std::vector<Target> targetsOf(const std::vector<BenchRow>& rows) {
@@ -183,6 +281,7 @@ std::vector<Target> targetsOf(const std::vector<BenchRow>& rows) {
             t.push_back({fmt::format("{} faster than POV-Ray ({:.2f}x)", name,
                                      r->povSeconds / std::max(r->nativeSeconds, 1e-9)),
                          r->nativeSeconds < r->povSeconds});
+    addEmbreeTargets(rows, t);
     return t;
 }
 
@@ -193,37 +292,57 @@ std::string targetsText(const std::vector<Target>& targets) {
     return t.empty() ? t : "\nTargets:\n" + t;
 }
 
+// One row of the table, without the Embree columns.
+std::string tableRow(const BenchRow& r) {
+    const std::string prims = r.primitives ? fmt::format("{}", *r.primitives) : "-";
+    const std::string native = r.nativeOk ? fmt::format("{:.2f} s", r.nativeSeconds) : "failed";
+    std::string pov = "-", timeRatio = "-", povRss = "-", rssRatio = "-";
+    if (r.povOk) {
+        pov = fmt::format("{:.2f} s", r.povSeconds);
+        if (r.povParseSeconds) pov += fmt::format(" ({:.2f} s)", *r.povParseSeconds);
+        timeRatio = fmt::format("{:.2f}", r.povSeconds / std::max(r.nativeSeconds, 1e-9));
+        povRss = humanBytes(r.povRss);
+        rssRatio =
+            fmt::format("{:.1f}", double(r.povRss) / double(std::max<uint64_t>(r.nativeRss, 1)));
+    } else if (!r.note.empty()) {
+        pov = r.note.substr(0, r.note.find('\n'));
+    }
+    return fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |", r.scene, prims, native,
+                       pov, timeRatio,
+                       r.raysPerSecond ? fmt::format("{:.0f}", *r.raysPerSecond) : "-",
+                       r.nativeOk ? humanBytes(r.nativeRss) : "-", povRss, rssRatio);
+}
+
+// The Embree columns of a row ("-" where Embree did not trace the scene).
+std::string embreeCells(const BenchRow& r) {
+    if (!r.embree) return " - | - | - | - |";
+    const EmbreeRun& e = *r.embree;
+    return fmt::format(" {:.2f} s | {:.2f} s | {:.0f} | {} |", e.buildSeconds, e.traceSeconds,
+                       e.raysPerSecond, humanBytes(e.peakRss));
+}
+
 std::string tableOf(const std::vector<BenchRow>& rows, const BenchOptions& o) {
+    const bool embree = std::any_of(rows.begin(), rows.end(),
+                                    [](const BenchRow& r) { return r.embree.has_value(); });
     std::string t =
         fmt::format("Benchmark of {}, {}: {}x{}, {} (both renderers), measured side by side.\n\n",
                     today(), machine(), o.width, o.height,
                     o.adaptive > 0 ? fmt::format("adaptive anti-aliasing {}", o.adaptive)
                                    : std::string("no anti-aliasing"));
     t += "| scene | primitives | native time | POV-Ray time (parse) | POV-Ray / native | rays/s | "
-         "native peak RSS | POV-Ray peak RSS | RSS ratio |\n";
-    t += "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-    for (const auto& r : rows) {
-        const std::string prims = r.primitives ? fmt::format("{}", *r.primitives) : "-";
-        const std::string native = r.nativeOk ? fmt::format("{:.2f} s", r.nativeSeconds) : "failed";
-        std::string pov = "-", timeRatio = "-", povRss = "-", rssRatio = "-";
-        if (r.povOk) {
-            pov = fmt::format("{:.2f} s", r.povSeconds);
-            if (r.povParseSeconds) pov += fmt::format(" ({:.2f} s)", *r.povParseSeconds);
-            timeRatio = fmt::format("{:.2f}", r.povSeconds / std::max(r.nativeSeconds, 1e-9));
-            povRss = humanBytes(r.povRss);
-            rssRatio = fmt::format("{:.1f}",
-                                   double(r.povRss) / double(std::max<uint64_t>(r.nativeRss, 1)));
-        } else if (!r.note.empty()) {
-            pov = r.note.substr(0, r.note.find('\n'));
-        }
-        t += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.scene, prims, native,
-                         pov, timeRatio,
-                         r.raysPerSecond ? fmt::format("{:.0f}", *r.raysPerSecond) : "-",
-                         r.nativeOk ? humanBytes(r.nativeRss) : "-", povRss, rssRatio);
-    }
+         "native peak RSS | POV-Ray peak RSS | RSS ratio |";
+    if (embree) t += " Embree build | Embree trace | Embree rays/s | Embree peak RSS |";
+    t += "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|";
+    if (embree) t += "---:|---:|---:|---:|";
+    t += "\n";
+    for (const auto& r : rows) t += tableRow(r) + (embree ? embreeCells(r) : "") + "\n";
     t += targetsText(targetsOf(rows));
     t += "\nPeak RSS is each whole render command's, as /usr/bin/time -v counts it; both "
          "write their PNG in-process.\n";
+    if (embree)
+        t += "Embree (pcsg-embree) traces the expanded mesh of each triangle-only scene: one "
+             "camera ray per pixel centre and one shadow ray per hit and light; its peak RSS is "
+             "its whole command's.\n";
     return t;
 }
 
@@ -238,6 +357,15 @@ nlohmann::json jsonOf(const std::vector<BenchRow>& rows, const BenchOptions& o) 
         if (r.raysPerSecond) e["rays_per_second"] = *r.raysPerSecond;
         if (r.primitives) e["primitive_equivalence"] = *r.primitives;
         if (!r.note.empty()) e["note"] = r.note;
+        if (r.nativeOk) e["native_command_seconds"] = r.nativeCommandSeconds;
+        if (r.embree) {
+            e["embree_triangles"] = r.embree->triangles;
+            e["embree_build_seconds"] = r.embree->buildSeconds;
+            e["embree_trace_seconds"] = r.embree->traceSeconds;
+            e["embree_rays_per_second"] = r.embree->raysPerSecond;
+            e["embree_seconds"] = r.embree->seconds;
+            e["embree_peak_rss_bytes"] = r.embree->peakRss;
+        }
         scenes.push_back(e);
     }
     nlohmann::json targets = nlohmann::json::array();
@@ -259,11 +387,12 @@ int runBench(BenchOptions o) {
         return 2;
     }
     const fs::path work = tmpl;
+    const std::optional<std::string> embree = findEmbree();
     std::vector<BenchRow> rows;
     int status = 0;
     for (const auto& scene : o.scenes) {
         if (!o.json) std::cerr << "bench: " << scene << " ...\n";
-        rows.push_back(benchScene(scene, o, work));
+        rows.push_back(benchScene(scene, o, work, embree));
         if (!rows.back().nativeOk) status = 1;
     }
     std::error_code ec;
@@ -293,8 +422,10 @@ void addBenchCommand(CLI::App& app, int& status) {
         "and print both times, their ratio, rays per second, both peak RSS values and the\n"
         "primitive equivalence (peak RSS of each whole render command), then which targets are\n"
         "met. Without scenes: the Sierpinski tetrahedron at orders 6, 8, 9, 10 and 12, the\n"
-        "sympodial tree and the terrain. Microbenchmarks of the hot paths are the\n"
-        "separate pcsg_microbench program (Google Benchmark).");
+        "sympodial tree and the terrain. When pcsg-embree is beside pcsg (built when Embree 3\n"
+        "is found), triangle-only scenes are also traced by Embree on the expanded mesh, the\n"
+        "yardstick. Microbenchmarks of the hot paths are the separate pcsg_microbench program\n"
+        "(Google Benchmark).");
     cmd->add_option("scenes", o->scenes, "Scene files (.pcsg)");
     cmd->add_option("--width", o->width, "Image width")
         ->capture_default_str()
@@ -311,7 +442,7 @@ void addBenchCommand(CLI::App& app, int& status) {
     cmd->add_option("--max-nodes", o->maxNodes, "Expansion budget for the exported tree")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    cmd->add_flag("--native-only", o->nativeOnly, "Render natively only (no POV-Ray)");
+    cmd->add_flag("--native-only", o->nativeOnly, "Render natively only (no POV-Ray, no Embree)");
     cmd->add_option("--markdown", o->markdown,
                     "Append the table, with date and machine, to this file");
     cmd->add_flag("--json", o->json, "Print the results as JSON");
