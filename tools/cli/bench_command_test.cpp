@@ -1,6 +1,7 @@
 // pcsg bench: the table it prints and appends, its JSON, and its verdicts on the targets.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "cli_test_util.h"
@@ -56,6 +57,42 @@ TEST(BenchCommand, SideBySideTableWithDateMachineAndTargets) {
     // Appending keeps what was there.
     ASSERT_EQ(pcsg({"bench", "--width", "48", "--height", "36", "--markdown", md, a}).exitCode, 0);
     EXPECT_EQ(readFile(md).substr(0, table.size()), table);
+}
+
+// With pcsg-embree beside pcsg (built when Embree 3 is found), a triangle-only scene gets
+// Embree's figures and the yardstick targets; a scene with other primitives does not.
+TEST(BenchCommand, EmbreeColumnsForTriangleOnlyScenes) {
+    if (!inPath("povray")) GTEST_SKIP() << "povray is not installed";
+    const auto embree = std::filesystem::path(PCSG_EXECUTABLE).parent_path() / "pcsg-embree";
+    if (!std::filesystem::exists(embree)) GTEST_SKIP() << "pcsg-embree is not built (no Embree)";
+    TempDir dir;
+    const std::string a = dir.write("sierpinski_8.pcsg", testing::kSierpinskiA);
+    const std::string b = dir.write("ball.pcsg", "sphere\n");
+    const std::string c = dir.write("sierpinski_9.pcsg", testing::kSierpinskiA);  // by name
+    const ChildResult r =
+        pcsg({"bench", "--json", "--width", "32", "--height", "24", "--threads", "2", a, b, c});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["scenes"].size(), 3u) << r.out;
+    const auto& s = j["scenes"][0];
+    EXPECT_EQ(s["embree_triangles"].get<uint64_t>(), 4096u * 4);  // order 6, 4 faces each
+    EXPECT_GT(s["embree_rays_per_second"].get<double>(), 0);
+    EXPECT_GT(s["embree_peak_rss_bytes"].get<uint64_t>(), 0u);
+    EXPECT_GE(s["embree_build_seconds"].get<double>(), 0);
+    EXPECT_GT(s["embree_seconds"].get<double>(), 0);
+    EXPECT_FALSE(j["scenes"][1].contains("embree_triangles")) << "a sphere is not a triangle";
+    std::string targets;
+    for (const auto& t : j["targets"]) targets += t["target"].get<std::string>() + "\n";
+    EXPECT_NE(targets.find("sierpinski_8 native trace rate within 3x of Embree's"),
+              std::string::npos)
+        << targets;
+    EXPECT_NE(targets.find("sierpinski_8 native peak RSS at most 1/20 of Embree's"),
+              std::string::npos)
+        << targets;
+    EXPECT_NE(targets.find("whole time (Embree's build included) ahead of Embree from order 9 "
+                           "on (order 9: "),
+              std::string::npos)
+        << targets;
 }
 
 TEST(BenchCommand, AMissingSceneFailsTheBench) {
