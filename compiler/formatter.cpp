@@ -14,7 +14,7 @@ namespace pcsg {
 
 namespace {
 
-constexpr char kBreak = '\x01';  // a place after `∪ ` where a long statement may break
+constexpr char kBreak = '\x01';  // where a long statement may break: after `∪ ` or a C-node's `; `
 
 // The precedence level of a binary operator (parser.cpp's table; `=` of a notation-B
 // condition is stored as Eq).
@@ -162,7 +162,7 @@ class Printer {
         std::string s = "{";
         for (uint32_t k = 0; k < n.count; ++k) {
             const Assign& a = ast_.assigns[n.first + k];
-            if (k > 0) s += "; ";
+            if (k > 0) s += "; \x01";  // a long C-node may break here too
             s += text(a.nameTok) + " = " + expr(a.value);
         }
         return s + "} " + child(n.child);

@@ -3,7 +3,8 @@
 // Statements keep their order, one per line; operators, C-nodes and directives get one
 // spacing; numbers, names and keywords keep their source text (so no value changes);
 // `|` `&` `→` become `∪` `∩` `->`; a statement wider than kFormatWidth columns is broken
-// after `∪` with continuation lines indented by kFormatIndent spaces. Parentheses are
+// after a `∪` (or a C-node's `;`), continuation lines indented by kFormatIndent spaces;
+// a directive too wide for one line gets one item per line. Parentheses are
 // printed where the grammar needs them to give the same syntax tree back.
 //
 // Comments (which the lexer drops) are found by position in the text and kept: a comment

@@ -17,5 +17,6 @@ void addExportCommand(CLI::App& app, int& status);  // export-pov
 void addStatsCommand(CLI::App& app, int& status);   // stats
 void addVerifyCommand(CLI::App& app, int& status);  // verify
 void addBenchCommand(CLI::App& app, int& status);   // bench
+void addFmtCommand(CLI::App& app, int& status);     // fmt
 
 }  // namespace pcsg::tools

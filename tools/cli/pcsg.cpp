@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     pcsg::tools::addStatsCommand(app, status);
     pcsg::tools::addVerifyCommand(app, status);
     pcsg::tools::addBenchCommand(app, status);
+    pcsg::tools::addFmtCommand(app, status);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -1,0 +1,75 @@
+// `pcsg fmt` run as a program: standard output, -i in place (atomically, nothing left
+// behind), compile errors and #define files leave the file alone, bad command lines.
+#include <gtest/gtest.h>
+
+#include "cli_test_util.h"
+
+namespace pcsg::tools {
+namespace {
+
+using testing::pcsg;
+using testing::readFile;
+using testing::TempDir;
+
+const char* kMessy =
+    "{c=2} S // axiom\nS if(c>0,2,1)\n1: S->sphere\n2: S->{c=c-1} (S|move(1,0,0)S)\n";
+const char* kCanonical =
+    "{c = 2} S // axiom\nS if(c > 0, 2, 1)\n1: S -> sphere\n"
+    "2: S -> {c = c - 1} (S ∪ move(1, 0, 0) S)\n";
+
+TEST(FmtCommand, PrintsTheCanonicalLayoutAndLeavesTheFileAlone) {
+    TempDir dir;
+    const std::string scene = dir.write("s.pcsg", kMessy);
+    const ChildResult r = pcsg({"fmt", scene});
+    ASSERT_TRUE(r.started);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.out, kCanonical);
+    EXPECT_EQ(readFile(scene), kMessy);
+}
+
+TEST(FmtCommand, InPlaceRewritesTheFileAndLeavesNothingBehind) {
+    TempDir dir;
+    const std::string scene = dir.write("s.pcsg", kMessy);
+    const ChildResult r = pcsg({"fmt", scene, "-i"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(readFile(scene), kCanonical);
+    EXPECT_EQ(testing::filesIn(dir.path()), std::vector<std::string>{"s.pcsg"});
+    EXPECT_EQ(pcsg({"fmt", scene, "-i"}).exitCode, 0);  // already canonical
+    EXPECT_EQ(readFile(scene), kCanonical);
+}
+
+TEST(FmtCommand, ACompileErrorExitsOneAndWritesNothing) {
+    TempDir dir;
+    const std::string bad = "{c=2} S\nS if(c>0,2,1)\n1: S -> sphere ∪\n";
+    const std::string scene = dir.write("bad.pcsg", bad);
+    const ChildResult r = pcsg({"fmt", scene, "-i"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("error:"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(readFile(scene), bad);
+    EXPECT_EQ(testing::filesIn(dir.path()), std::vector<std::string>{"bad.pcsg"});
+}
+
+TEST(FmtCommand, AFileWithDefineIsRefused) {
+    TempDir dir;
+    const std::string text = "#define BALL sphere\nBALL\n";
+    const std::string scene = dir.write("m.pcsg", text);
+    const ChildResult r = pcsg({"fmt", scene, "-i"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("pcsg fmt does not format files with #define yet"), std::string::npos)
+        << r.err;
+    EXPECT_EQ(readFile(scene), text);
+}
+
+TEST(FmtCommand, BadCommandLinesExitTwo) {
+    EXPECT_EQ(pcsg({"fmt"}).exitCode, 2);
+    EXPECT_EQ(pcsg({"fmt", "-", "-i"}).exitCode, 2);
+    EXPECT_EQ(pcsg({"fmt", "a.pcsg", "--nope"}).exitCode, 2);
+    const ChildResult help = pcsg({"fmt", "--help"});
+    EXPECT_EQ(help.exitCode, 0);
+    EXPECT_NE(help.out.find("#define"), std::string::npos) << help.out;
+}
+
+}  // namespace
+}  // namespace pcsg::tools
