@@ -64,17 +64,6 @@ constexpr KeywordEntry kKeywords[] = {
     {"flipxz", Kw::FlipXZ},
     {"flipxy", Kw::FlipXY},
     {"matrix", Kw::Matrix},
-    {"sphere", Kw::Sphere},
-    {"cube", Kw::Cube},
-    {"cylinder", Kw::Cylinder},
-    {"cone", Kw::Cone},
-    {"tetrahedron", Kw::Tetrahedron},
-    {"torus", Kw::Torus},
-    {"plane", Kw::Plane},
-    {"empty", Kw::Empty},
-    {"tri1", Kw::Tri1},
-    {"tri2", Kw::Tri2},
-    {"triangle", Kw::Triangle},
     {"if", Kw::If},
     {"rand", Kw::Rand},
     {"choose", Kw::Choose},
@@ -107,6 +96,7 @@ const std::unordered_map<std::string_view, Kw>& keywordTable() {
     static const std::unordered_map<std::string_view, Kw> table = [] {
         std::unordered_map<std::string_view, Kw> t;
         for (const auto& e : kKeywords) t.emplace(e.name, e.kw);
+        for (const PrimitiveInfo& p : kPrimitiveTable) t.emplace(p.name, primitiveKeyword(p.kind));
         return t;
     }();
     return table;
@@ -125,6 +115,8 @@ Kw keywordOf(std::string_view word) {
 std::string_view keywordName(Kw k) {
     for (const auto& e : kKeywords)
         if (e.kw == k) return e.name;
+    for (const PrimitiveInfo& p : kPrimitiveTable)
+        if (primitiveKeyword(p.kind) == k) return p.name;
     return "?";
 }
 

@@ -18,6 +18,7 @@
 
 #include "diagnostics.h"
 #include "graph.h"
+#include "primitive_table.h"
 
 namespace pcsg {
 
@@ -96,6 +97,7 @@ enum class Kw : uint8_t {
     FlipXZ,
     FlipXY,
     Matrix,
+    // the primitives, in PrimitiveKind order (their names are primitive_table.h's)
     Sphere,
     Cube,
     Cylinder,
@@ -166,6 +168,12 @@ struct TokenStream {
 // Lexes `src` and expands its macros. Errors go to `diags`; the stream is usable (ends
 // with End) even then, so that the parser can report more errors.
 TokenStream lex(const Source& src, Diagnostics& diags);
+
+// The keyword of a primitive (the Kw values of the primitives follow PrimitiveKind).
+constexpr Kw primitiveKeyword(PrimitiveKind k) {
+    return static_cast<Kw>(static_cast<int>(Kw::Sphere) + static_cast<int>(k));
+}
+static_assert(primitiveKeyword(PrimitiveKind::Triangle) == Kw::Triangle);
 
 // The spelling of a token ("end of line" for a Newline): for messages.
 std::string describe(const Source& src, const Token& t);
