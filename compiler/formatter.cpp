@@ -56,6 +56,11 @@ std::string paren(std::string_view s) {
     return cat({"(", s, ")"});
 }
 
+std::string_view rtrim(std::string_view s) {
+    while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+    return s;
+}
+
 // Display width: UTF-8 code points.
 size_t width(std::string_view s) {
     size_t w = 0;
@@ -236,13 +241,13 @@ class Printer {
         std::string out, line = chunks[0];
         for (size_t k = 1; k < chunks.size(); ++k) {
             std::string next = line + chunks[k];
-            while (!next.empty() && next.back() == ' ') next.pop_back();
-            if (width(next) > kFormatWidth) {
-                while (!line.empty() && line.back() == ' ') line.pop_back();
-                out += line + "\n";
+            // Break only a line that holds something: a short head stays with a long
+            // operand that would not fit on a line of its own either.
+            if (width(rtrim(next)) > kFormatWidth && width(rtrim(line)) >= kFormatWidth / 2) {
+                out.append(rtrim(line)).append("\n");
                 line = std::string(kFormatIndent, ' ') + chunks[k];
             } else {
-                line += chunks[k];
+                line = std::move(next);
             }
         }
         return out + line;

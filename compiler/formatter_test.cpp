@@ -180,6 +180,28 @@ TEST(Formatter, LongRulesBreakAfterUnion) {
     EXPECT_EQ(format(out), out);
 }
 
+// Spellings the scenes do not use: notation B with `=` in a condition, grouped runs of
+// one operator, unary operators, calls, empty C-nodes, the ASCII operators.
+TEST(Formatter, TrickySpellingsKeepTheirGraph) {
+    const std::string text =
+        "w:  S(6)   /* axiom */ ; // after a semicolon\n"
+        "p1: S(c) : c = 0 -> tetrahedron\n"
+        "p2: S(c) : c > 0 -> move(0.5,0.5,0.5) uscale(0.5) S(c-1) | ( ( T(c) ) ) & sphere \\ "
+        "cube \\ (cube \\ cube) | ((S(c-1) | S(c-1)) | S(c-1))\n"
+        "p3: T(x) -> {} {a=+x , b=!x} rot(1,2,3,e*pi) zshear(1, 2) matrix(1,0,0, 0,1,0, "
+        "0,0,1, 0,0,0) scale(-x^2, (-x)^2, 2^-x) sphere\n";
+    const std::string once = format(text);
+    EXPECT_EQ(format(once), once);
+    EXPECT_NE(once.find("p1: S(c) : c = 0 -> tetrahedron\n"), std::string::npos) << once;
+    EXPECT_NE(once.find("((S(c - 1) ∪ S(c - 1)) ∪ S(c - 1))"), std::string::npos) << once;
+    EXPECT_NE(once.find("w: S(6) /* axiom */ // after a semicolon\n"), std::string::npos) << once;
+    const auto a = testing::compile(text);
+    const auto b = testing::compile(once);
+    ASSERT_TRUE(a->graph) << a->errors();
+    ASSERT_TRUE(b->graph) << b->errors();
+    expectSameGraph(*a->graph, *b->graph);
+}
+
 TEST(Formatter, ErrorsGiveNoOutput) {
     Diagnostics diags;
     EXPECT_FALSE(formatScene("bad.pcsg", "S ∪\n", diags));
