@@ -20,6 +20,28 @@ std::string format(const std::string& text) {
     return out.value_or("");
 }
 
+void expectSameVec(const Vec3& a, const Vec3& b) {
+    EXPECT_EQ(a.x, b.x);
+    EXPECT_EQ(a.y, b.y);
+    EXPECT_EQ(a.z, b.z);
+}
+
+// The directives: camera, lights, background, settings.
+void expectSameScene(const Scene& a, const Scene& b) {
+    expectSameVec(a.camera.location, b.camera.location);
+    expectSameVec(a.camera.lookAt, b.camera.lookAt);
+    expectSameVec(a.camera.sky, b.camera.sky);
+    EXPECT_EQ(a.camera.angle, b.camera.angle);
+    ASSERT_EQ(a.lights.size(), b.lights.size());
+    for (size_t k = 0; k < a.lights.size(); ++k) {
+        expectSameVec(a.lights[k].position, b.lights[k].position);
+        expectSameVec(a.lights[k].color, b.lights[k].color);
+    }
+    expectSameVec(a.background, b.background);
+    EXPECT_EQ(a.settings.seed, b.settings.seed);
+    EXPECT_EQ(a.settings.maxDepth, b.settings.maxDepth);
+}
+
 // The graphs agree in everything but source locations and texts.
 void expectSameGraph(const Graph& a, const Graph& b) {
     ASSERT_EQ(a.nodes.size(), b.nodes.size());
@@ -57,8 +79,15 @@ void expectSameGraph(const Graph& a, const Graph& b) {
     for (size_t k = 0; k < a.primitives.size(); ++k)
         EXPECT_EQ(a.primitives[k].values, b.primitives[k].values) << k;
     ASSERT_EQ(a.materials.size(), b.materials.size());
-    for (size_t k = 0; k < a.materials.size(); ++k)
-        EXPECT_EQ(a.materials[k].name, b.materials[k].name);
+    for (size_t k = 0; k < a.materials.size(); ++k) {
+        const Material &m = a.materials[k], &n = b.materials[k];
+        EXPECT_EQ(m.name, n.name);
+        expectSameVec(m.color, n.color);
+        EXPECT_EQ(std::vector<double>({m.ambient, m.diffuse, m.phong, m.phongSize, m.reflection}),
+                  std::vector<double>({n.ambient, n.diffuse, n.phong, n.phongSize, n.reflection}));
+    }
+    expectSameScene(a.scene, b.scene);
+    EXPECT_EQ(a.timedValues.size(), b.timedValues.size());
 }
 
 const std::filesystem::path kRoot = std::filesystem::path(__FILE__).parent_path().parent_path();
