@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <initializer_list>
+#include <map>
 #include <vector>
 
 #include "ast.h"
@@ -68,10 +69,22 @@ size_t width(std::string_view s) {
     return w;
 }
 
+struct Span {
+    uint32_t begin = 0, end = 0;
+};
+
+// The comments inside each C-node's braces (by CsgNode index): such a C-node is printed
+// over several lines, one assignment a line, so that its comments stay with them.
+using CalcComments = std::map<uint32_t, std::vector<Span>>;
+
+constexpr char kIndentMore = '\x02';  // a new line, indented one step more than the `{`'s
+constexpr char kIndentSame = '\x03';  // a new line, indented as the `{`'s
+
 class Printer {
   public:
-    Printer(const Source& src, const std::vector<Token>& tokens, const Ast& ast)
-        : src_(src), t_(tokens), ast_(ast) {}
+    Printer(const Source& src, const std::vector<Token>& tokens, const Ast& ast,
+            const CalcComments& calcComments)
+        : src_(src), t_(tokens), ast_(ast), calcComments_(calcComments) {}
 
     // One statement, possibly over several lines, without a final newline.
     std::string statement(const Stmt& s) const {
@@ -163,7 +176,38 @@ class Printer {
         return ast_.csg[c].kind == CsgKind::Operator ? paren(s) : s;
     }
 
-    std::string calc(const CsgNode& n) const {
+    std::string comment(Span c) const {
+        return std::string(src_.text().substr(c.begin, c.end - c.begin));
+    }
+
+    // A C-node with comments: each assignment on a line of its own, a comment after it
+    // on its line, others on lines of their own before the next assignment or the `}`.
+    std::string calcLines(const CsgNode& n, const std::vector<Span>& cs) const {
+        const std::string_view text = src_.text();
+        std::string s = "{";
+        size_t ci = 0;
+        for (uint32_t k = 0; k < n.count; ++k) {
+            const Assign& a = ast_.assigns[n.first + k];
+            const Token& last = t_[ast_.exprs[a.value].to];
+            const uint32_t end = last.offset + last.length;
+            for (; ci < cs.size() && cs[ci].begin < t_[a.nameTok].offset; ++ci)
+                s += cat({std::string_view(&kIndentMore, 1), comment(cs[ci])});
+            s += cat({std::string_view(&kIndentMore, 1),
+                      text.substr(t_[a.nameTok].offset, t_[a.nameTok].length), " = ",
+                      expr(a.value)});
+            for (; ci < cs.size() && cs[ci].begin >= end &&
+                   text.substr(end, cs[ci].begin - end).find('\n') == std::string_view::npos;
+                 ++ci)
+                s += cat({" ", comment(cs[ci])});
+        }
+        for (; ci < cs.size(); ++ci) s += cat({std::string_view(&kIndentMore, 1), comment(cs[ci])});
+        return cat({s, std::string_view(&kIndentSame, 1), "} ", child(n.child)});
+    }
+
+    std::string calc(uint32_t c) const {
+        const CsgNode& n = ast_.csg[c];
+        if (auto it = calcComments_.find(c); it != calcComments_.end())
+            return calcLines(n, it->second);
         std::string s = "{";
         for (uint32_t k = 0; k < n.count; ++k) {
             const Assign& a = ast_.assigns[n.first + k];
@@ -185,7 +229,7 @@ class Printer {
                     {text(n.tok), flip ? "" : paren(list(n.first, n.count)), " ", child(n.child)});
             }
             case CsgKind::Calc:
-                return calc(n);
+                return calc(c);
             case CsgKind::Paint:
                 return cat({"paint(", text(n.nameTok), ") ", child(n.child)});
             case CsgKind::Primitive: {
@@ -228,27 +272,44 @@ class Printer {
         }
     }
 
+    // Appends a chunk to the current line; a C-node's line marks start new lines,
+    // indented from the line its `{` is on.
+    static void append(std::string& out, std::string& line, std::string_view chunk) {
+        size_t base = std::string::npos;
+        for (char ch : chunk) {
+            if (ch != kIndentMore && ch != kIndentSame) {
+                line += ch;
+                continue;
+            }
+            if (base == std::string::npos) base = line.find_first_not_of(' ');
+            if (base == std::string::npos) base = 0;
+            out.append(rtrim(line)).append("\n");
+            line.assign(base + (ch == kIndentMore ? kFormatIndent : 0), ' ');
+        }
+    }
+
     // Breaks a flat statement at its break marks, filling each line up to the width.
     static std::string fill(const std::string& flat) {
-        std::vector<std::string> chunks;
+        std::vector<std::string_view> chunks;
         size_t start = 0;
         for (size_t i = 0; i <= flat.size(); ++i) {
             if (i == flat.size() || flat[i] == kBreak) {
-                chunks.push_back(flat.substr(start, i - start));
+                chunks.push_back(std::string_view(flat).substr(start, i - start));
                 start = i + 1;
             }
         }
-        std::string out, line = chunks[0];
+        std::string out, line;
+        append(out, line, chunks[0]);
         for (size_t k = 1; k < chunks.size(); ++k) {
-            std::string next = line + chunks[k];
+            const std::string_view head = chunks[k].substr(0, chunks[k].find_first_of("\x02\x03"));
+            const std::string next = cat({line, head});
             // Break only a line that holds something: a short head stays with a long
             // operand that would not fit on a line of its own either.
             if (width(rtrim(next)) > kFormatWidth && width(rtrim(line)) >= kFormatWidth / 2) {
                 out.append(rtrim(line)).append("\n");
-                line = std::string(kFormatIndent, ' ') + chunks[k];
-            } else {
-                line = std::move(next);
+                line.assign(kFormatIndent, ' ');
             }
+            append(out, line, chunks[k]);
         }
         return out + line;
     }
@@ -288,10 +349,7 @@ class Printer {
     const Source& src_;
     const std::vector<Token>& t_;
     const Ast& ast_;
-};
-
-struct Span {
-    uint32_t begin = 0, end = 0;
+    const CalcComments& calcComments_;
 };
 
 // The comments of a text, in order, and the offset of a `#` outside them (or none).
@@ -316,6 +374,27 @@ Scan scanComments(std::string_view s) {
         ++i;
     }
     return scan;
+}
+
+// The comments inside C-nodes' braces; `used` marks them.
+CalcComments calcComments(const Ast& ast, const std::vector<Token>& t,
+                          const std::vector<Span>& comments, std::vector<bool>& used) {
+    CalcComments result;
+    if (comments.empty()) return result;
+    for (uint32_t c = 0; c < ast.csg.size(); ++c) {
+        if (ast.csg[c].kind != CsgKind::Calc) continue;
+        size_t j = ast.csg[c].tok + 1;
+        for (int depth = 1; depth > 0 && t[j].kind != Tok::End; ++j)
+            depth += t[j].kind == Tok::LBrace ? 1 : t[j].kind == Tok::RBrace ? -1 : 0;
+        const uint32_t open = t[ast.csg[c].tok].offset, close = t[j - 1].offset;
+        auto it = std::lower_bound(comments.begin(), comments.end(), open,
+                                   [](const Span& s, uint32_t at) { return s.begin < at; });
+        for (; it != comments.end() && it->begin < close; ++it) {
+            result[c].push_back(*it);
+            used[static_cast<size_t>(it - comments.begin())] = true;
+        }
+    }
+    return result;
 }
 
 // Each statement's text: its first token to its last.
@@ -411,9 +490,14 @@ std::optional<std::string> formatScene(std::string_view fileName, std::string_vi
     Diagnostics quiet;  // the file compiled: lexing and parsing it again report nothing
     const TokenStream tokens = lex(src, quiet);
     const Ast ast = parse(src, tokens, quiet);
-    const Printer printer(src, tokens.tokens, ast);
+    std::vector<bool> used(scan.comments.size(), false);
+    const CalcComments inCalcs = calcComments(ast, tokens.tokens, scan.comments, used);
+    std::vector<Span> others;
+    for (size_t k = 0; k < scan.comments.size(); ++k)
+        if (!used[k]) others.push_back(scan.comments[k]);
+    const Printer printer(src, tokens.tokens, ast, inCalcs);
     const std::vector<Span> spans = statementSpans(ast, tokens.tokens);
-    const Placement place = placeComments(text, spans, scan.comments);
+    const Placement place = placeComments(text, spans, others);
     Emitter out(text);
     size_t ci = 0;
     for (size_t k = 0; k < ast.stmts.size(); ++k) {

@@ -156,6 +156,37 @@ TEST(Formatter, CommentsSurvive) {
     EXPECT_EQ(format(expected), expected);
 }
 
+TEST(Formatter, CommentsInACNodeStayWithTheirAssignments) {
+    const std::string text =
+        "sphere ∪ {   n = 2;   // count\n"
+        "    r = 0.5;  /* radius */\n"
+        "    // the last one\n"
+        "    k = n*r\n"
+        "    // after all\n"
+        "} S\n"
+        "S if(n > 0, 2, 1)\n"
+        "1: S -> uscale(r) sphere\n"
+        "2: S -> {n = n - 1} move(k, 0, 0) S\n";
+    const std::string expected =
+        "sphere ∪ {\n"
+        "    n = 2 // count\n"
+        "    r = 0.5 /* radius */\n"
+        "    // the last one\n"
+        "    k = n * r\n"
+        "    // after all\n"
+        "} S\n"
+        "S if(n > 0, 2, 1)\n"
+        "1: S -> uscale(r) sphere\n"
+        "2: S -> {n = n - 1} move(k, 0, 0) S\n";
+    EXPECT_EQ(format(text), expected);
+    EXPECT_EQ(format(expected), expected);
+    const auto a = testing::compile(text);
+    const auto b = testing::compile(expected);
+    ASSERT_TRUE(a->graph) << a->errors();
+    ASSERT_TRUE(b->graph) << b->errors();
+    expectSameGraph(*a->graph, *b->graph);
+}
+
 // Written by hand: what each messy spelling becomes.
 TEST(Formatter, MessyInputBecomesCanonical) {
     const std::string messy =
