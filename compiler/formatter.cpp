@@ -15,7 +15,8 @@ namespace pcsg {
 
 namespace {
 
-constexpr char kBreak = '\x01';  // where a long statement may break: after `∪ ` or a C-node's `; `
+constexpr char kBreak = '\x01';      // where a long statement may break: after an operator
+constexpr char kBreakCalc = '\x04';  // after a C-node's `;`: only when its operand is too long
 
 // The precedence level of a binary operator (parser.cpp's table; `=` of a notation-B
 // condition is stored as Eq).
@@ -151,8 +152,8 @@ class Printer {
 
     std::string operatorCsg(const CsgNode& n) const {
         const char* sep = n.csgOp == CsgOp::Union          ? " ∪ \x01"
-                          : n.csgOp == CsgOp::Intersection ? " ∩ "
-                                                           : " \\ ";
+                          : n.csgOp == CsgOp::Intersection ? " ∩ \x01"
+                                                           : " \\ \x01";
         std::string s;
         for (uint32_t k = 0; k < n.count; ++k) {
             const uint32_t c = ast_.lists[n.first + k];
@@ -211,7 +212,7 @@ class Printer {
         std::string s = "{";
         for (uint32_t k = 0; k < n.count; ++k) {
             const Assign& a = ast_.assigns[n.first + k];
-            if (k > 0) s += "; \x01";  // a long C-node may break here too
+            if (k > 0) s += "; \x04";  // a long C-node may break here too
             s += text(a.nameTok) + " = " + expr(a.value);
         }
         return s + "} " + child(n.child);
@@ -288,24 +289,43 @@ class Printer {
         }
     }
 
-    // Breaks a flat statement at its break marks, filling each line up to the width.
+    // Whether `line` followed by the chunks [k, m) (up to a C-node's first line break)
+    // fits in the width; stops reading once it does not.
+    static bool fits(const std::string& line, const std::vector<std::string_view>& chunks, size_t k,
+                     size_t m) {
+        std::string s = line;
+        for (size_t i = k; i < m; ++i) {
+            const size_t special = chunks[i].find_first_of("\x02\x03");
+            s += chunks[i].substr(0, special);
+            if (special != std::string_view::npos || width(rtrim(s)) > kFormatWidth) break;
+        }
+        return width(rtrim(s)) <= kFormatWidth;
+    }
+
+    // Breaks a flat statement at its break marks, filling each line up to the width: an
+    // operator's operand goes on the next line when it does not fit on this one, and a
+    // C-node's `;` breaks only inside an operand too long for a line.
     static std::string fill(const std::string& flat) {
         std::vector<std::string_view> chunks;
+        std::vector<bool> calc;  // chunk k follows a C-node's break
         size_t start = 0;
         for (size_t i = 0; i <= flat.size(); ++i) {
-            if (i == flat.size() || flat[i] == kBreak) {
+            if (i == flat.size() || flat[i] == kBreak || flat[i] == kBreakCalc) {
                 chunks.push_back(std::string_view(flat).substr(start, i - start));
+                calc.push_back(start > 0 && flat[start - 1] == kBreakCalc);
                 start = i + 1;
             }
         }
         std::string out, line;
         append(out, line, chunks[0]);
         for (size_t k = 1; k < chunks.size(); ++k) {
-            const std::string_view head = chunks[k].substr(0, chunks[k].find_first_of("\x02\x03"));
-            const std::string next = cat({line, head});
-            // Break only a line that holds something: a short head stays with a long
-            // operand that would not fit on a line of its own either.
-            if (width(rtrim(next)) > kFormatWidth && width(rtrim(line)) >= kFormatWidth / 2) {
+            size_t m = k + 1;  // the end of this operand
+            while (m < chunks.size() && calc[m]) ++m;
+            const bool fitting = calc[k] ? fits(line, chunks, k, k + 1) : fits(line, chunks, k, m);
+            // Break only a line that holds something; at a C-node's `;`, a short head
+            // stays with the rest, which would not fit on a line of its own either.
+            const size_t least = calc[k] ? kFormatWidth / 2 : kFormatIndent + 1;
+            if (!fitting && width(rtrim(line)) >= least) {
                 out.append(rtrim(line)).append("\n");
                 line.assign(kFormatIndent, ' ');
             }

@@ -3,9 +3,10 @@
 // Statements keep their order, one per line; operators, C-nodes and directives get one
 // spacing; numbers, names and keywords keep their source text (so no value changes);
 // `|` `&` `→` become `∪` `∩` `->`; a statement wider than kFormatWidth columns is broken
-// after a `∪` (or a C-node's `;`), continuation lines indented by kFormatIndent spaces;
-// a directive too wide for one line gets one item per line. Parentheses are
-// printed where the grammar needs them to give the same syntax tree back.
+// after `∪` (or `∩`, `\`) before an operand that does not fit, and at a C-node's `;`
+// only inside an operand too long for a line; continuation lines are indented by
+// kFormatIndent spaces, and a directive too wide for one line gets one item per line.
+// Parentheses are printed where the grammar needs them to give the same tree back.
 //
 // Comments (which the lexer drops) are found by position in the text and kept: a comment
 // before a statement stays on its own line(s) before it, one after a statement's end on

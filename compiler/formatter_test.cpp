@@ -262,6 +262,24 @@ TEST(Formatter, TrickySpellingsKeepTheirGraph) {
     expectSameGraph(*a->graph, *b->graph);
 }
 
+// An operand goes to the next line whole; a C-node breaks at its `;` only when one
+// operand is too long for a line, and a short head is not broken off.
+TEST(Formatter, OperandsMoveWholeAndCNodesBreakLast) {
+    const std::string text =
+        "material meadow {}\nSTEM = sphere\n"
+        "paint(meadow) plane | {np=21;p=np;rs=0.035;lean=3.5;ll=0.75} ({n=6;l=0.75} STEM | "
+        "{n=5;l=0.68} move(-1.1,0.5,0) rotz(60) STEM | {n=4;l=0.62} move(1.0,0.7,0) rotz(200) "
+        "STEM)\n";
+    const std::string expected =
+        "material meadow {}\nSTEM = sphere\n"
+        "paint(meadow) plane ∪ {np = 21; p = np; rs = 0.035; lean = 3.5; ll = 0.75} "
+        "({n = 6; l = 0.75} STEM ∪\n"
+        "    {n = 5; l = 0.68} move(-1.1, 0.5, 0) rotz(60) STEM ∪\n"
+        "    {n = 4; l = 0.62} move(1.0, 0.7, 0) rotz(200) STEM)\n";
+    EXPECT_EQ(format(text), expected);
+    EXPECT_EQ(format(expected), expected);
+}
+
 TEST(Formatter, ErrorsGiveNoOutput) {
     Diagnostics diags;
     EXPECT_FALSE(formatScene("bad.pcsg", "S ∪\n", diags));
