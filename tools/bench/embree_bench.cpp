@@ -56,72 +56,75 @@ struct Figures {
     uint64_t peakRssBytes = 0;
 };
 
-// The scene as one indexed triangle mesh in world coordinates.
-struct Mesh {
-    std::vector<float> vertices;    // x y z per vertex
-    std::vector<uint32_t> indices;  // 3 per triangle
-    std::string unsupported;        // why the scene is not triangle-only (empty: it is)
-};
-
-void addVertex(Mesh& m, const Affine& toWorld, const Vec3& p) {
-    const Vec3 w = toWorld.point(p);
-    m.vertices.insert(m.vertices.end(), {float(w.x), float(w.y), float(w.z)});
-}
-
-// Why the tree cannot be traced as a mesh, or nothing: every operator must be a union.
-std::string nonUnionOperator(const ExpandedTree& tree) {
+// Why the expanded tree cannot be traced as one triangle mesh, or nothing: every operator
+// must be a union, and every primitive a triangle or a tetrahedron (its 4 faces).
+std::string unsupportedIn(const ExpandedTree& tree) {
     for (const TreeNode& n : tree.nodes)
         if (!n.primitive && n.op != CsgOp::Union)
             return "the scene has an intersection or difference (CSG), which a triangle mesh "
                    "cannot express";
+    for (const TreePrimitive& p : tree.primitives)
+        if (p.kind != PrimitiveKind::Tetrahedron && !isTriangle(p.kind))
+            return fmt::format(
+                "the scene has a {} primitive; pcsg-embree traces only triangles "
+                "(triangle, tri1, tri2) and tetrahedra",
+                primitiveInfo(p.kind).name);
     return {};
 }
 
-Mesh meshOf(const ExpandedTree& tree) {
-    Mesh m;
-    m.unsupported = nonUnionOperator(tree);
-    if (!m.unsupported.empty()) return m;
+// The mesh's size: 4 vertices and 4 faces per tetrahedron, 3 and 1 per triangle.
+void meshSize(const ExpandedTree& tree, size_t& vertices, size_t& triangles) {
+    vertices = triangles = 0;
     for (const TreePrimitive& p : tree.primitives) {
-        const uint32_t base = uint32_t(m.vertices.size() / 3);
-        if (p.kind == PrimitiveKind::Tetrahedron) {
-            for (const Vec3& v : kTetraVertices) addVertex(m, p.toWorld, v);
-            // Face i is opposite vertex i.
-            m.indices.insert(m.indices.end(),
-                             {base + 1, base + 2, base + 3, base, base + 2, base + 3, base,
-                              base + 1, base + 3, base, base + 1, base + 2});
-        } else if (p.kind == PrimitiveKind::Triangle || p.kind == PrimitiveKind::Tri1 ||
-                   p.kind == PrimitiveKind::Tri2) {
-            Vec3 c[3];
-            triangleCorners(p.kind, p.firstArg == kNone ? nullptr : &tree.args[p.firstArg], c);
-            for (const Vec3& v : c) addVertex(m, p.toWorld, v);
-            m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
-        } else {
-            m.unsupported = fmt::format(
-                "the scene has a {} primitive; pcsg-embree traces only "
-                "triangles (triangle, tri1, tri2) and tetrahedra",
-                primitiveInfo(p.kind).name);
-            return m;
-        }
+        const bool tetra = p.kind == PrimitiveKind::Tetrahedron;
+        vertices += tetra ? 4 : 3;
+        triangles += tetra ? 4 : 1;
     }
-    return m;
 }
 
-// Builds the Embree scene of the mesh at Embree's best quality for a static scene: a high
-// quality (spatial split) BVH, no dynamic or compact flags, as Embree's documentation
-// recommends for the fastest traversal.
-RTCScene buildScene(RTCDevice device, const Mesh& m) {
+// Writes the world-space mesh of the tree into Embree's vertex and index buffers.
+void fillMesh(const ExpandedTree& tree, float* v, uint32_t* i) {
+    uint32_t base = 0;
+    auto vertex = [&v](const Affine& toWorld, const Vec3& p) {
+        const Vec3 w = toWorld.point(p);
+        *v++ = float(w.x), *v++ = float(w.y), *v++ = float(w.z);
+    };
+    for (const TreePrimitive& p : tree.primitives) {
+        if (p.kind == PrimitiveKind::Tetrahedron) {
+            for (const Vec3& c : kTetraVertices) vertex(p.toWorld, c);
+            // Face k is opposite vertex k.
+            for (const uint32_t f : {1u, 2u, 3u, 0u, 2u, 3u, 0u, 1u, 3u, 0u, 1u, 2u})
+                *i++ = base + f;
+            base += 4;
+        } else {
+            Vec3 c[3];
+            triangleCorners(p.kind, p.firstArg == kNone ? nullptr : &tree.args[p.firstArg], c);
+            for (const Vec3& corner : c) vertex(p.toWorld, corner);
+            *i++ = base, *i++ = base + 1, *i++ = base + 2;
+            base += 3;
+        }
+    }
+}
+
+// Builds the Embree scene of the tree's mesh at Embree's best quality for a static scene:
+// a high-quality (spatial split) BVH, no dynamic, compact or robust flags, as Embree's
+// documentation recommends for the fastest traversal. The mesh goes straight into
+// Embree's buffers, and the tree is released before the BVH is built.
+RTCScene buildScene(RTCDevice device, ExpandedTree tree, uint64_t& triangles) {
     RTCScene scene = rtcNewScene(device);
     rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
-    const size_t nv = m.vertices.size() / 3, nt = m.indices.size() / 3;
+    size_t nv = 0, nt = 0;
+    meshSize(tree, nv, nt);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
         geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
     auto* i = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
         geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), nt));
-    std::copy(m.vertices.begin(), m.vertices.end(), v);
-    std::copy(m.indices.begin(), m.indices.end(), i);
+    fillMesh(tree, v, i);
+    tree = ExpandedTree{};
+    triangles = nt;
     rtcCommitGeometry(geom);
     rtcAttachGeometry(scene, geom);
     rtcReleaseGeometry(geom);
@@ -220,28 +223,27 @@ void print(const Options& o, const Figures& f) {
         f.traceSeconds, f.rays, raysPerSecond, f.peakRssBytes / 1e6);
 }
 
-// Compiles and expands the scene into a mesh; nothing (with the message printed) when it
-// cannot be traced, and the exit status in `status`.
-std::optional<Mesh> loadMesh(const Options& o, Graph& g, Figures& f, int& status) {
+// Expands the scene; nothing (with the message printed) when it cannot be traced as a
+// triangle mesh, and the exit status in `status`.
+std::optional<ExpandedTree> loadTree(const Options& o, Graph& g, Figures& f, int& status) {
     const Clock::time_point start = Clock::now();
-    std::optional<Mesh> mesh;
+    std::optional<ExpandedTree> tree;
     try {
         ExpandOptions eo;
         eo.maxNodes = o.maxNodes;
-        mesh = meshOf(expand(g, eo));
+        tree = expand(g, eo);
     } catch (const std::exception& e) {
         std::cerr << "pcsg-embree: " << o.scene << ": " << e.what() << "\n";
         status = 1;
         return std::nullopt;
     }
     f.expandSeconds = secondsSince(start);
-    if (!mesh->unsupported.empty()) {
-        std::cerr << "pcsg-embree: " << o.scene << ": " << mesh->unsupported << "\n";
+    if (const std::string why = unsupportedIn(*tree); !why.empty()) {
+        std::cerr << "pcsg-embree: " << o.scene << ": " << why << "\n";
         status = 2;
         return std::nullopt;
     }
-    f.triangles = mesh->indices.size() / 3;
-    return mesh;
+    return tree;
 }
 
 int run(const Options& o) {
@@ -250,17 +252,17 @@ int run(const Options& o) {
     if (!compiled.graph) return 1;
     Figures f;
     int status = 0;
-    std::optional<Mesh> mesh = loadMesh(o, *compiled.graph, f, status);
-    if (!mesh) return status;
+    std::optional<ExpandedTree> tree = loadTree(o, *compiled.graph, f, status);
+    if (!tree) return status;
     RTCDevice device = rtcNewDevice(fmt::format("threads={}", o.threads).c_str());
     if (!device) {
         std::cerr << "pcsg-embree: cannot create an Embree device\n";
         return 1;
     }
     Clock::time_point start = Clock::now();
-    RTCScene scene = buildScene(device, *mesh);
+    RTCScene scene = buildScene(device, std::move(*tree), f.triangles);
+    tree.reset();
     f.buildSeconds = secondsSince(start);
-    mesh.reset();  // Embree holds its own copy of the buffers
     start = Clock::now();
     trace(scene, compiled.graph->scene, o, f);
     f.traceSeconds = secondsSince(start);
