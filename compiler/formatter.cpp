@@ -74,9 +74,15 @@ struct Span {
     uint32_t begin = 0, end = 0;
 };
 
-// The comments inside each C-node's braces (by CsgNode index): such a C-node is printed
-// over several lines, one assignment a line, so that its comments stay with them.
-using CalcComments = std::map<uint32_t, std::vector<Span>>;
+// The comments inside braces, by the token index of the `{`: such a C-node or directive
+// is printed over several lines, one item a line, so that its comments stay with them.
+using BraceComments = std::map<uint32_t, std::vector<Span>>;
+
+// An assignment of a C-node or an item of a directive: its text and its source span.
+struct Item {
+    Span span;
+    std::string text;
+};
 
 constexpr char kIndentMore = '\x02';  // a new line, indented one step more than the `{`'s
 constexpr char kIndentSame = '\x03';  // a new line, indented as the `{`'s
@@ -84,8 +90,8 @@ constexpr char kIndentSame = '\x03';  // a new line, indented as the `{`'s
 class Printer {
   public:
     Printer(const Source& src, const std::vector<Token>& tokens, const Ast& ast,
-            const CalcComments& calcComments)
-        : src_(src), t_(tokens), ast_(ast), calcComments_(calcComments) {}
+            const BraceComments& braceComments)
+        : src_(src), t_(tokens), ast_(ast), braceComments_(braceComments) {}
 
     // One statement, possibly over several lines, without a final newline.
     std::string statement(const Stmt& s) const {
@@ -181,33 +187,48 @@ class Printer {
         return std::string(src_.text().substr(c.begin, c.end - c.begin));
     }
 
-    // A C-node with comments: each assignment on a line of its own, a comment after it
-    // on its line, others on lines of their own before the next assignment or the `}`.
-    std::string calcLines(const CsgNode& n, const std::vector<Span>& cs) const {
+    uint32_t endOf(uint32_t tok) const { return t_[tok].offset + t_[tok].length; }
+
+    // The lines of a braced list with comments: each item on a line of its own, a comment
+    // after an item on its line, other comments on lines of their own before the next
+    // item or the `}`.
+    std::vector<std::string> itemLines(const std::vector<Item>& items,
+                                       const std::vector<Span>& cs) const {
         const std::string_view text = src_.text();
-        std::string s = "{";
+        std::vector<std::string> lines;
         size_t ci = 0;
-        for (uint32_t k = 0; k < n.count; ++k) {
-            const Assign& a = ast_.assigns[n.first + k];
-            const Token& last = t_[ast_.exprs[a.value].to];
-            const uint32_t end = last.offset + last.length;
-            for (; ci < cs.size() && cs[ci].begin < t_[a.nameTok].offset; ++ci)
-                s += cat({std::string_view(&kIndentMore, 1), comment(cs[ci])});
-            s += cat({std::string_view(&kIndentMore, 1),
-                      text.substr(t_[a.nameTok].offset, t_[a.nameTok].length), " = ",
-                      expr(a.value)});
+        for (const Item& item : items) {
+            for (; ci < cs.size() && cs[ci].begin < item.span.begin; ++ci)
+                lines.push_back(comment(cs[ci]));
+            std::string line = item.text;
+            const uint32_t end = item.span.end;
             for (; ci < cs.size() && cs[ci].begin >= end &&
                    text.substr(end, cs[ci].begin - end).find('\n') == std::string_view::npos;
                  ++ci)
-                s += cat({" ", comment(cs[ci])});
+                line += cat({" ", comment(cs[ci])});
+            lines.push_back(std::move(line));
         }
-        for (; ci < cs.size(); ++ci) s += cat({std::string_view(&kIndentMore, 1), comment(cs[ci])});
+        for (; ci < cs.size(); ++ci) lines.push_back(comment(cs[ci]));
+        return lines;
+    }
+
+    // A C-node with comments: one assignment a line (see itemLines).
+    std::string calcLines(const CsgNode& n, const std::vector<Span>& cs) const {
+        std::vector<Item> items;
+        for (uint32_t k = 0; k < n.count; ++k) {
+            const Assign& a = ast_.assigns[n.first + k];
+            items.push_back({{t_[a.nameTok].offset, endOf(ast_.exprs[a.value].to)},
+                             cat({text(a.nameTok), " = ", expr(a.value)})});
+        }
+        std::string s = "{";
+        for (const std::string& line : itemLines(items, cs))
+            s += cat({std::string_view(&kIndentMore, 1), line});
         return cat({s, std::string_view(&kIndentSame, 1), "} ", child(n.child)});
     }
 
     std::string calc(uint32_t c) const {
         const CsgNode& n = ast_.csg[c];
-        if (auto it = calcComments_.find(c); it != calcComments_.end())
+        if (auto it = braceComments_.find(n.tok); it != braceComments_.end())
             return calcLines(n, it->second);
         std::string s = "{";
         for (uint32_t k = 0; k < n.count; ++k) {
@@ -350,17 +371,31 @@ class Printer {
         std::string head = text(s.tok);
         if (s.directive == Kw::Background) return head + " " + vector(ast_.items[s.first]);
         if (s.directive == Kw::Material) head += cat({" ", text(s.nameTok)});
-        std::vector<std::string> items;
+        std::vector<Item> list;
         for (uint32_t k = 0; k < s.count; ++k) {
             const DirectiveItem& item = ast_.items[s.first + k];
-            items.push_back(text(item.nameTok) + " " +
-                            (item.vector ? vector(item) : expr(item.e[0])));
+            // A vector ends at its '>', the token after its last component.
+            const uint32_t last =
+                item.vector ? ast_.exprs[item.e[2]].to + 1 : ast_.exprs[item.e[0]].to;
+            list.push_back(
+                {{t_[item.nameTok].offset, endOf(last)},
+                 cat({text(item.nameTok), " ", item.vector ? vector(item) : expr(item.e[0])})});
         }
+        uint32_t open = s.tok;
+        while (t_[open].kind != Tok::LBrace) ++open;
+        if (auto it = braceComments_.find(open); it != braceComments_.end())
+            return lines(head, itemLines(list, it->second));
+        std::vector<std::string> items;
+        for (Item& item : list) items.push_back(std::move(item.text));
         if (items.empty()) return head + " {}";
         std::string one = head + " {";
         for (size_t k = 0; k < items.size(); ++k) one += cat({k > 0 ? "  " : " ", items[k]});
         one += " }";
         if (width(one) <= kFormatWidth) return one;
+        return lines(head, items);
+    }
+
+    static std::string lines(const std::string& head, const std::vector<std::string>& items) {
         std::string many = head + " {\n";
         for (const std::string& item : items) many += std::string(kFormatIndent, ' ') + item + "\n";
         return many + "}";
@@ -369,7 +404,7 @@ class Printer {
     const Source& src_;
     const std::vector<Token>& t_;
     const Ast& ast_;
-    const CalcComments& calcComments_;
+    const BraceComments& braceComments_;
 };
 
 // The comments of a text, in order, and the offset of a `#` outside them (or none).
@@ -396,21 +431,22 @@ Scan scanComments(std::string_view s) {
     return scan;
 }
 
-// The comments inside C-nodes' braces; `used` marks them.
-CalcComments calcComments(const Ast& ast, const std::vector<Token>& t,
-                          const std::vector<Span>& comments, std::vector<bool>& used) {
-    CalcComments result;
+// The comments inside braces (C-nodes and directives); `used` marks them.
+BraceComments braceComments(const std::vector<Token>& t, const std::vector<Span>& comments,
+                            std::vector<bool>& used) {
+    BraceComments result;
     if (comments.empty()) return result;
-    for (uint32_t c = 0; c < ast.csg.size(); ++c) {
-        if (ast.csg[c].kind != CsgKind::Calc) continue;
-        size_t j = ast.csg[c].tok + 1;
+    for (uint32_t i = 0; i < t.size(); ++i) {
+        if (t[i].kind != Tok::LBrace) continue;
+        size_t j = i + 1;
         for (int depth = 1; depth > 0 && t[j].kind != Tok::End; ++j)
             depth += t[j].kind == Tok::LBrace ? 1 : t[j].kind == Tok::RBrace ? -1 : 0;
-        const uint32_t open = t[ast.csg[c].tok].offset, close = t[j - 1].offset;
+        const uint32_t open = t[i].offset, close = t[j - 1].offset;
         auto it = std::lower_bound(comments.begin(), comments.end(), open,
                                    [](const Span& s, uint32_t at) { return s.begin < at; });
         for (; it != comments.end() && it->begin < close; ++it) {
-            result[c].push_back(*it);
+            if (used[static_cast<size_t>(it - comments.begin())]) continue;
+            result[i].push_back(*it);
             used[static_cast<size_t>(it - comments.begin())] = true;
         }
     }
@@ -511,11 +547,11 @@ std::optional<std::string> formatScene(std::string_view fileName, std::string_vi
     const TokenStream tokens = lex(src, quiet);
     const Ast ast = parse(src, tokens, quiet);
     std::vector<bool> used(scan.comments.size(), false);
-    const CalcComments inCalcs = calcComments(ast, tokens.tokens, scan.comments, used);
+    const BraceComments inBraces = braceComments(tokens.tokens, scan.comments, used);
     std::vector<Span> others;
     for (size_t k = 0; k < scan.comments.size(); ++k)
         if (!used[k]) others.push_back(scan.comments[k]);
-    const Printer printer(src, tokens.tokens, ast, inCalcs);
+    const Printer printer(src, tokens.tokens, ast, inBraces);
     const std::vector<Span> spans = statementSpans(ast, tokens.tokens);
     const Placement place = placeComments(text, spans, others);
     Emitter out(text);

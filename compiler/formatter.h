@@ -10,10 +10,11 @@
 //
 // Comments (which the lexer drops) are found by position in the text and kept: a comment
 // before a statement stays on its own line(s) before it, one after a statement's end on
-// the same line stays there, one inside a C-node's braces puts the C-node over several
-// lines (one assignment a line, the comment after its assignment or on a line of its own
-// before the next), and any other inside a statement's text moves to a line of its own
-// just before that statement. One blank line is kept where the text had one or more.
+// the same line stays there, one inside the braces of a C-node or a directive puts it
+// over several lines (one assignment or item a line, the comment after its item or on a
+// line of its own before the next), and any other inside a statement's text moves to a
+// line of its own just before that statement. One blank line is kept where the text had one or
+// more.
 //
 // A file that uses #define is refused (the lexer expands macros before the parser, so
 // the tree no longer shows them): "pcsg fmt does not format files with #define yet".

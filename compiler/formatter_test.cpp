@@ -187,6 +187,22 @@ TEST(Formatter, CommentsInACNodeStayWithTheirAssignments) {
     expectSameGraph(*a->graph, *b->graph);
 }
 
+TEST(Formatter, CommentsInADirectiveStayWithTheirItems) {
+    const std::string text =
+        "camera {\n  location <1,2,3> // where\n  // what to look at\n  look_at <0,0,0>\n"
+        "  angle 30 /* wide */\n}\nsphere\n";
+    const std::string expected =
+        "camera {\n"
+        "    location <1, 2, 3> // where\n"
+        "    // what to look at\n"
+        "    look_at <0, 0, 0>\n"
+        "    angle 30 /* wide */\n"
+        "}\n"
+        "sphere\n";
+    EXPECT_EQ(format(text), expected);
+    EXPECT_EQ(format(expected), expected);
+}
+
 // Written by hand: what each messy spelling becomes.
 TEST(Formatter, MessyInputBecomesCanonical) {
     const std::string messy =

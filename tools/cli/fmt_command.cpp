@@ -91,7 +91,8 @@ void addFmtCommand(CLI::App& app, int& status) {
         "fmt",
         "Print a scene in its canonical layout (as gofmt does): one statement per line, one "
         "spacing, `∪ ∩ \\` and `->`, numbers as written, lines over 100 columns broken after "
-        "`∪` (or `∩`, `\\`), comments kept (in a C-node beside their assignments, one a line; "
+        "`∪` (or `∩`, `\\`), comments kept (in a C-node or directive beside their items, one a "
+        "line; "
         "elsewhere inside a "
         "statement moved to the line before it). A scene that "
         "does not compile gets its errors and exit status 1, and nothing is written. Files "
