@@ -62,6 +62,28 @@ TEST(FmtCommand, AFileWithDefineIsRefused) {
     EXPECT_EQ(readFile(scene), text);
 }
 
+// The formatted scene renders the same image, byte for byte.
+TEST(FmtCommand, TheFormattedSceneRendersTheSameImage) {
+    TempDir dir;
+    for (const char* text : {testing::kSierpinskiA, testing::kSierpinskiB}) {
+        const std::string scene = dir.write("s.pcsg", text);
+        const ChildResult f = pcsg({"fmt", scene});
+        ASSERT_EQ(f.exitCode, 0) << f.err;
+        const std::string formatted = dir.write("f.pcsg", f.out);
+        ASSERT_EQ(
+            pcsg({"render", scene, "-o", dir.file("a.png"), "--width", "48", "--height", "36"})
+                .exitCode,
+            0);
+        ASSERT_EQ(
+            pcsg({"render", formatted, "-o", dir.file("b.png"), "--width", "48", "--height", "36"})
+                .exitCode,
+            0);
+        const std::string a = readFile(dir.file("a.png"));
+        EXPECT_FALSE(a.empty());
+        EXPECT_EQ(a, readFile(dir.file("b.png")));
+    }
+}
+
 TEST(FmtCommand, BadCommandLinesExitTwo) {
     EXPECT_EQ(pcsg({"fmt"}).exitCode, 2);
     EXPECT_EQ(pcsg({"fmt", "-", "-i"}).exitCode, 2);
