@@ -24,6 +24,7 @@
 
 #include "child_process.h"
 #include "commands.h"
+#include "frames.h"
 #include "image_helper.h"
 #include "renders.h"
 #include "scene_input.h"
@@ -46,6 +47,12 @@ struct VerifyOptions : VerifySettings {
     bool keep = false;
     std::string imageHelper;  // pcsg-image
     double clock = 0;         // --clock: both sides render the still at this time
+    // --frames N [--clock-range A,B] [--cyclic] [--all-frames]: compare frames of an
+    // animation, by default the first, the middle and the last of N.
+    int frames = 0;
+    std::string clockRange;
+    bool cyclic = false;
+    bool allFrames = false;
     // The arguments that pass --clock on to render and export-pov (none without it).
     std::vector<std::string> clockArgs() const {
         if (clock == 0) return {};
@@ -165,7 +172,7 @@ void compareSides(SceneResult& r, const VerifyOptions& o, const fs::path& work) 
     r.message = r.metrics.agree ? "the images agree" : "the images differ";
 }
 
-// Verifies one scene, writing its images into root/dir.
+// Verifies one scene (at o.clock), writing its images into root/dir.
 SceneResult verifyScene(const std::string& scene, const std::string& dir, const VerifyOptions& o,
                         const fs::path& root) {
     SceneResult r;
@@ -188,9 +195,15 @@ std::string ratio(const std::optional<uint64_t>& big, const std::optional<uint64
     return fmt::format("{:.1f}x", double(*big) / double(*small));
 }
 
+// "frame 3 of 5 (clock 0.5)" for a frame of --frames, nothing for a still.
+std::string frameLabel(const SceneResult& r) {
+    if (r.frames == 0) return {};
+    return fmt::format(" frame {} of {} (clock {})", r.frame, r.frames, r.clock);
+}
+
 void printResult(const SceneResult& r, std::ostream& out) {
     const char* verdict = r.status == 0 ? "AGREE" : (r.status == 1 ? "DIFFER" : "ERROR");
-    out << fmt::format("{}: {} ({})\n", r.scene, verdict, r.message);
+    out << fmt::format("{}{}: {} ({})\n", r.scene, frameLabel(r), verdict, r.message);
     if (r.metrics.width > 0) {
         const auto& m = r.metrics;
         out << fmt::format(
@@ -217,6 +230,11 @@ nlohmann::json toJson(const SceneResult& r) {
     j["scene"] = r.scene;
     j["status"] = r.status == 0 ? "agree" : (r.status == 1 ? "differ" : "error");
     j["message"] = r.message;
+    if (r.frames > 0) {
+        j["frame"] = r.frame;
+        j["frames"] = r.frames;
+        j["clock"] = r.clock;
+    }
     if (r.metrics.width > 0) {
         const auto& m = r.metrics;
         j["width"] = m.width;
@@ -281,7 +299,8 @@ void printSummary(const std::vector<SceneResult>& results, const VerifyOptions& 
     }
     size_t agree = 0;
     for (const auto& r : results) agree += r.status == 0;
-    std::cout << fmt::format("{} of {} scene(s) agree", agree, results.size());
+    std::cout << fmt::format("{} of {} {} agree", agree, results.size(),
+                             o.frames > 0 ? "frame(s)" : "scene(s)");
     if (!o.reportDir.empty())
         std::cout << "; report: " << (root / "index.html").string();
     else if (o.keep)
@@ -289,8 +308,69 @@ void printSummary(const std::vector<SceneResult>& results, const VerifyOptions& 
     std::cout << "\n";
 }
 
+// The frames of --frames to compare: the first, the middle and the last of N (each once),
+// or all of them with --all-frames; none without --frames (a still). False (with the
+// error printed) for a wrong --clock-range.
+bool framesToCompare(const VerifyOptions& o, FramePlan& plan, std::vector<int>& frames) {
+    if (o.frames == 0) return true;
+    plan.frames = o.frames;
+    plan.cyclic = o.cyclic;
+    plan.first = 1;
+    plan.last = o.frames;
+    if (!o.clockRange.empty()) {
+        std::string error;
+        const auto range = parseClockRange(o.clockRange, error);
+        if (!range) {
+            std::cerr << "pcsg verify: error: " << error << "\n";
+            return false;
+        }
+        std::tie(plan.clockFrom, plan.clockTo) = *range;
+    }
+    std::set<int> chosen;
+    if (o.allFrames) {
+        for (int f = 1; f <= o.frames; ++f) chosen.insert(f);
+    } else {
+        chosen = {1, (o.frames + 1) / 2, o.frames};
+    }
+    frames.assign(chosen.begin(), chosen.end());
+    return true;
+}
+
+// Verifies one scene: the still, or each frame of `frames` at its clock (its images in
+// a directory of its own, "NAME_frameF").
+void verifySceneFrames(const std::string& scene, VerifyOptions o, const FramePlan& plan,
+                       const std::vector<int>& frames, std::set<std::string>& dirs,
+                       const fs::path& root, std::vector<SceneResult>& results, int& status,
+                       const std::string& written) {
+    const size_t runs = std::max<size_t>(1, frames.size());
+    for (size_t i = 0; i < runs; ++i) {
+        std::string dirKey = scene;
+        if (!frames.empty()) {
+            o.clock = frameClock(plan, frames[i]);
+            dirKey = fmt::format("{}_frame{}", fs::path(scene).stem().string(), frames[i]);
+        }
+        SceneResult r = verifyScene(scene, reportDirName(dirKey, dirs), o, root);
+        if (!frames.empty()) {
+            r.frame = frames[i];
+            r.frames = plan.frames;
+            r.clock = o.clock;
+            r.name += fmt::format(" frame {} (clock {})", r.frame, r.clock);  // the report's title
+        }
+        if (!o.json) printResult(r, std::cout);
+        status = std::max(status, r.status);
+        results.push_back(std::move(r));
+        if (!o.reportDir.empty()) {
+            writeScenePage(results.back(), o, written, root);
+            writeIndex(results, 0, o, written, root);
+        }
+    }
+}
+
 int runVerify(VerifyOptions o) {
     if (!addSceneDirectory(o)) return 2;
+    FramePlan plan;
+    std::vector<int> frames;
+    if (!framesToCompare(o, plan, frames)) return 2;
     if (o.scenes.empty()) {
         std::cerr << "pcsg verify: no scene given (a .pcsg file, or --all DIR)\n";
         return 2;
@@ -317,14 +397,7 @@ int runVerify(VerifyOptions o) {
     std::set<std::string> dirs = {"index.html"};  // the report's own page is taken
     for (const auto& scene : o.scenes) {
         if (!o.json && o.scenes.size() > 1) std::cerr << "verifying " << scene << " ...\n";
-        SceneResult r = verifyScene(scene, reportDirName(scene, dirs), o, root);
-        if (!o.json) printResult(r, std::cout);
-        status = std::max(status, r.status);
-        results.push_back(std::move(r));
-        if (!o.reportDir.empty()) {
-            writeScenePage(results.back(), o, written, root);
-            writeIndex(results, o.scenes.size() - results.size(), o, written, root);
-        }
+        verifySceneFrames(scene, o, plan, frames, dirs, root, results, status, written);
     }
     printSummary(results, o, root);
     std::error_code ec;
@@ -362,7 +435,19 @@ void addVerifyCommand(CLI::App& app, int& status) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--report", o->reportDir,
                     "Write an HTML report into this directory; open DIR/index.html");
-    addClockOption(cmd, o->clock);
+    auto* clock = addClockOption(cmd, o->clock);
+    auto* frames = cmd->add_option("--frames", o->frames,
+                                   "Compare frames of an animation of N frames (numbered as "
+                                   "`pcsg render --frames`): the first, the middle and the last")
+                       ->check(CLI::Range(1, 1000000));
+    clock->excludes(frames);
+    cmd->add_option("--clock-range", o->clockRange,
+                    "A,B: the clocks of the first and last frame (default 0,1)")
+        ->needs(frames);
+    cmd->add_flag("--cyclic", o->cyclic,
+                  "A cyclic animation (POV-Ray's +KC): the clock steps by (B-A)/N")
+        ->needs(frames);
+    cmd->add_flag("--all-frames", o->allFrames, "Compare every frame of the N")->needs(frames);
     cmd->add_option("--pov", o->povFile, "Render this POV-Ray file instead of exporting the scene");
     cmd->add_option("--pixel-threshold", o->thresholds.pixelOff,
                     "A pixel is off when a channel differs by more than this (0..1)")

@@ -41,6 +41,9 @@ struct SceneResult {
     std::string povFile;  // the POV-Ray scene: a file name in dir, or --pov's path
     bool povInReport = false;
     std::string source;  // the scene's text, for the report
+    // A frame of `verify --frames`: its number, of how many, and its clock (frames 0: a still).
+    int frame = 0, frames = 0;
+    double clock = 0;
 };
 
 // An optional figure: bytes ("1.2 MB") or a plain count, "-" when it is missing.
