@@ -16,10 +16,12 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <tuple>
 
 #include "commands.h"
 #include "eval.h"
 #include "expander.h"
+#include "frames.h"
 #include "pov_writer.h"
 #include "scene_input.h"
 #include "stats.h"
@@ -40,6 +42,9 @@ struct ExportOptions {
     uint32_t maxUnion = 32;
     bool json = false;
     double clock = 0;  // --clock: the frame's time
+    int frames = 0;    // --frames N: one file per frame, a driver and an .ini (0: a still)
+    std::string clockRange;
+    bool cyclic = false;
 };
 
 // Unrolls the graph; nullopt (with the error printed) when the scene is at fault.
@@ -121,12 +126,85 @@ void printExport(const ExportOptions& o, const Stats& s, const PovWriteStats& wr
             written.skipped, written.skipped == 1 ? "" : "s");
 }
 
+int exportOne(const ExportOptions& o, Graph& g, const CompiledScene& compiled);
+
+// --frames N: OUT01.pov ... (each frame at its time, as `pcsg render --frames` names its
+// images), OUT.pov a driver that includes frame `frame_number`'s file, and OUT.ini that
+// makes POV-Ray render frames 1..N of the driver into OUT01.png ... (`povray OUT.ini`).
+int runExportFrames(const ExportOptions& o, CompiledScene& compiled) {
+    namespace fs = std::filesystem;
+    FramePlan plan;
+    plan.frames = o.frames;
+    plan.cyclic = o.cyclic;
+    std::string error;
+    if (!o.clockRange.empty()) {
+        const auto range = parseClockRange(o.clockRange, error);
+        if (!range) {
+            std::cerr << "pcsg export-pov: error: " << error << "\n";
+            return 2;
+        }
+        std::tie(plan.clockFrom, plan.clockTo) = *range;
+    }
+    Graph& g = *compiled.graph;
+    for (int f = 1; f <= o.frames; ++f) {
+        ExportOptions fo = o;
+        fo.output = frameFileName(o.output, f, o.frames);
+        const double clock = frameClock(plan, f);
+        if (!setSceneTime(g, Time{clock, f}, std::cerr)) {
+            std::cerr << fmt::format("  at frame {} of {}, clock {}\n", f, o.frames, clock);
+            return 1;
+        }
+        if (const int status = exportOne(fo, g, compiled)) return status;
+    }
+    const fs::path out(o.output);
+    const std::string stem = out.stem().string();
+    const int width = static_cast<int>(std::to_string(o.frames).size());
+    std::ofstream driver(out, std::ios::trunc);
+    driver << fmt::format(
+        "// {} frames of {}, exported by pcsg export-pov --frames: render them all with\n"
+        "//   povray {}.ini\n"
+        "// (frame f is {}<f>.pov, its number zero-padded to {} digit(s)).\n"
+        "#include concat(\"{}\", str(frame_number, -{}, 0), \".pov\")\n",
+        o.frames, o.scene, stem, stem, width, stem, width);
+    const fs::path ini = out.parent_path() / (stem + ".ini");
+    std::ofstream iniOut(ini, std::ios::trunc);
+    iniOut << fmt::format(
+        "; {} frames of {}, exported by pcsg export-pov --frames. Run `povray {}.ini`\n"
+        "; (from this directory): POV-Ray renders frame f of the driver {}.pov, which\n"
+        "; includes {}<f>.pov, into {}<f>.png, the names `pcsg render --frames` writes.\n"
+        "Input_File_Name={}.pov\nOutput_File_Name={}.png\nOutput_File_Type=N\n"
+        "Initial_Frame=1\nFinal_Frame={}\nWidth={}\nHeight={}\n",
+        o.frames, o.scene, stem, stem, stem, stem, stem, stem, o.frames, o.width, o.height);
+    driver.close();
+    iniOut.close();
+    if (!driver || !iniOut) {
+        std::cerr << "pcsg export-pov: cannot write " << out.string() << " or " << ini.string()
+                  << "\n";
+        return 2;
+    }
+    if (!o.json)
+        std::cout << fmt::format("{}: wrote {} frames, the driver {} and {} (povray {})\n", o.scene,
+                                 o.frames, out.string(), ini.string(), ini.filename().string());
+    return 0;
+}
+
 int runExport(const ExportOptions& o) {
     CompiledScene compiled = compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
     Graph& g = *compiled.graph;
+    if (o.frames > 0) {
+        if (o.output == "-") {
+            std::cerr << "pcsg export-pov: error: --frames writes files: -o - is not allowed\n";
+            return 2;
+        }
+        return runExportFrames(o, compiled);
+    }
     if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
+    return exportOne(o, g, compiled);
+}
 
+// Exports the graph at the time it is set to.
+int exportOne(const ExportOptions& o, Graph& g, const CompiledScene& compiled) {
     const auto start = std::chrono::steady_clock::now();
     const std::optional<ExpandedTree> tree = expandScene(g, o);
     if (!tree) return 1;
@@ -191,7 +269,20 @@ void addExportCommand(CLI::App& app, int& status) {
                    "this many per level")
         ->capture_default_str()
         ->check(CLI::Range(2u, 100000u));
-    addClockOption(ex, e->clock);
+    auto* clock = addClockOption(ex, e->clock);
+    auto* frames =
+        ex->add_option("--frames", e->frames,
+                       "Export N frames of an animation: OUT01.pov ... (named as `pcsg render "
+                       "--frames` names images), the driver OUT.pov and OUT.ini: `povray "
+                       "OUT.ini` renders them all into OUT01.png ...")
+            ->check(CLI::Range(1, 1000000));
+    clock->excludes(frames);
+    ex->add_option("--clock-range", e->clockRange,
+                   "A,B: the clocks of the first and last frame (default 0,1)")
+        ->needs(frames);
+    ex->add_flag("--cyclic", e->cyclic,
+                 "A cyclic animation (POV-Ray's +KC): the clock steps by (B-A)/N")
+        ->needs(frames);
     ex->add_flag("--json", e->json, "Print the export's figures as JSON");
     ex->callback([e, &status] { status = runExport(*e); });
 }

@@ -45,6 +45,7 @@
 #include "scene_time.h"
 #include "stats.h"
 #include "traversal.h"
+#include "video.h"
 
 namespace pcsg::tools {
 
@@ -67,6 +68,8 @@ struct RenderCommandOptions {
     int frames = 0;    // --frames N: a sequence (0: a still)
     std::string clockRange, subset;
     bool cyclic = false;
+    double fps = 24;          // a video's frame rate
+    bool keepFrames = false;  // a video's frames are kept next to it
 };
 
 // A progress bar on standard error, redrawn at most every 1%.
@@ -357,8 +360,49 @@ void printText(const RenderCommandOptions& o, const RenderReport& report) {
 
 int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
              const std::string& imageHelper);
+int runRender(const RenderCommandOptions& o);
+
+// A video (-o OUT.mp4, .webm, .gif): the frames rendered as PNG files, then encoded by
+// ffmpeg; checked before anything is rendered.
+int runVideo(const RenderCommandOptions& o) {
+    if (o.frames == 0) {
+        std::cerr << "pcsg render: error: a video (" << o.output << ") needs --frames N\n";
+        return 2;
+    }
+    if (!inPath("ffmpeg")) {
+        std::cerr << "pcsg render: cannot write '" << o.output
+                  << "': ffmpeg is not installed (it encodes the frames): install it with "
+                     "`apt-get install ffmpeg`\n";
+        return 2;
+    }
+    FramePlan plan;
+    if (!framePlan(o, plan)) return 2;
+    VideoFrames frames;
+    std::string error;
+    if (!videoFramesFor(o.output, o.keepFrames, frames, error)) {
+        std::cerr << "pcsg render: " << error << "\n";
+        return 2;
+    }
+    RenderCommandOptions fo = o;
+    fo.output = frames.pattern;
+    int status = runRender(fo);
+    if (status == 0) {
+        error = encodeVideo(o.output, frames.pattern, plan.first, plan.last, plan.frames, o.fps);
+        if (!error.empty()) {
+            std::cerr << "pcsg render: " << error << "\n";
+            status = 2;
+        } else if (!o.json) {
+            std::cout << fmt::format("{}: wrote {} ({} frames at {} fps{})\n", o.scene, o.output,
+                                     plan.last - plan.first + 1, o.fps,
+                                     o.keepFrames ? ", frames kept" : "");
+        }
+    }
+    removeVideoFrames(frames);
+    return status;
+}
 
 int runRender(const RenderCommandOptions& o) {
+    if (isVideoOutput(o.output)) return runVideo(o);
     FramePlan plan;
     if (o.frames > 0 && !framePlan(o, plan)) return 2;
     // Before the render: without a writer, the render would be for nothing.
@@ -412,8 +456,9 @@ int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
 // CLI11 validator: the output's extension names an image type pcsg writes.
 const CLI::Validator kImageOutput(
     [](const std::string& path) -> std::string {
-        if (imageFormatOf(path)) return {};
-        return fmt::format("cannot write '{}': unknown image type ({})", path, kImageTypesHint);
+        if (imageFormatOf(path) || isVideoOutput(path)) return {};
+        return fmt::format("cannot write '{}': unknown image type ({}; a video: .mp4, .webm, .gif)",
+                           path, kImageTypesHint);
     },
     "IMAGE");
 
@@ -435,6 +480,13 @@ void addTimeOptions(CLI::App* cmd, RenderCommandOptions& o) {
                   "frame is not B")
         ->needs(frames);
     cmd->add_option("--subset", o.subset, "F,L: render only frames F to L of the N")->needs(frames);
+    cmd->add_option("--fps", o.fps, "A video's frame rate (-o OUT.mp4, .webm or .gif)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 1000.0))
+        ->needs(frames);
+    cmd->add_flag("--keep-frames", o.keepFrames,
+                  "Keep a video's frames, as PNG files next to it under POV-Ray's names")
+        ->needs(frames);
 }
 
 }  // namespace
@@ -452,7 +504,9 @@ void addRenderCommand(CLI::App& app, int& status) {
         "pcsg, or in PATH), which gets the pixels through a pipe once they exist.\n"
         "Exit status: 0 written, 1 the scene has an error (nothing written), 2 could not run.");
     cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input)")->required();
-    cmd->add_option("-o,--output", o->output, "The image to write: .png, .exr, .tif or .tiff")
+    cmd->add_option("-o,--output", o->output,
+                    "The image to write: .png, .exr, .tif or .tiff; or a video with --frames: "
+                    ".mp4, .webm or .gif (encoded by ffmpeg)")
         ->required()
         ->check(kImageOutput);
     cmd->add_option("--width", o->width, "Image width in pixels")
