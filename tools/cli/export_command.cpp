@@ -42,6 +42,7 @@ struct ExportOptions {
     uint32_t maxUnion = 32;
     bool json = false;
     double clock = 0;  // --clock: the frame's time
+    int frame = 1;     // --frame: the still's frame number
     int frames = 0;    // --frames N: one file per frame, a driver and an .ini (0: a still)
     std::string clockRange;
     bool cyclic = false;
@@ -199,7 +200,7 @@ int runExport(const ExportOptions& o) {
         }
         return runExportFrames(o, compiled);
     }
-    if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
+    if (!setSceneTime(g, Time{o.clock, o.frame}, std::cerr)) return 1;
     return exportOne(o, g, compiled);
 }
 
@@ -277,6 +278,7 @@ void addExportCommand(CLI::App& app, int& status) {
                        "OUT.ini` renders them all into OUT01.png ...")
             ->check(CLI::Range(1, 1000000));
     clock->excludes(frames);
+    addFrameOption(ex, e->frame)->excludes(frames);
     ex->add_option("--clock-range", e->clockRange,
                    "A,B: the clocks of the first and last frame (default 0,1)")
         ->needs(frames);

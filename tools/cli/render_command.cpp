@@ -65,6 +65,7 @@ struct RenderCommandOptions {
     size_t expansionCacheMb = 16;
     uint64_t countVisits = 20'000'000;
     double clock = 0;  // --clock: the still's time
+    int frame = 1;     // --frame: the still's frame number
     int frames = 0;    // --frames N: a sequence (0: a still)
     std::string clockRange, subset;
     bool cyclic = false;
@@ -426,7 +427,7 @@ int runRender(const RenderCommandOptions& o) {
 int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
              const std::string& imageHelper) {
     Graph& g = *compiled.graph;
-    if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
+    if (!setSceneTime(g, Time{o.clock, o.frame}, std::cerr)) return 1;
     RenderReport report;
     if (const int status = countAndRender(g, o, report)) return status;
     if (const std::string error = writeOutput(o, imageHelper, report); !error.empty()) {
@@ -472,6 +473,7 @@ void addTimeOptions(CLI::App* cmd, RenderCommandOptions& o) {
                         "... OUT24.png); frame f has clock A + (f-1)(B-A)/(N-1)")
             ->check(CLI::Range(1, 1000000));
     clock->excludes(frames);
+    addFrameOption(cmd, o.frame)->excludes(frames);
     cmd->add_option("--clock-range", o.clockRange,
                     "A,B: the clocks of the first and last frame (default 0,1)")
         ->needs(frames);

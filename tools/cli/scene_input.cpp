@@ -44,6 +44,14 @@ bool setSceneTime(Graph& g, Time t, std::ostream& err) {
     }
 }
 
+CLI::Option* addFrameOption(CLI::App* cmd, int& frame) {
+    return cmd
+        ->add_option("--frame", frame,
+                     "The frame number of the still: `frame` reads it (default 1); with "
+                     "--clock, frame F of a sequence rendered alone")
+        ->check(CLI::Range(1, 1000000));
+}
+
 CLI::Option* addClockOption(CLI::App* cmd, double& clock) {
     const CLI::Validator finite(
         [](const std::string& s) -> std::string {

@@ -28,4 +28,8 @@ bool setSceneTime(Graph& g, Time t, std::ostream& err);
 // Adds `--clock X` to a subcommand: the clock of the still (frame 1), a finite number.
 CLI::Option* addClockOption(CLI::App* cmd, double& clock);
 
+// --frame F: the frame number the still reads as `frame` (default 1), for one frame of a
+// sequence rendered alone (`pcsg verify --frames` passes it on).
+CLI::Option* addFrameOption(CLI::App* cmd, int& frame);
+
 }  // namespace pcsg::tools

@@ -25,13 +25,14 @@ struct StatsOptions {
     bool json = false;
     uint64_t maxVisits = 4'000'000'000ULL;
     double clock = 0;  // --clock: the frame counted
+    int frame = 1;     // --frame: its frame number
 };
 
 int runStats(const StatsOptions& o) {
     CompiledScene compiled = compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
     Graph& g = *compiled.graph;
-    if (!setSceneTime(g, Time{o.clock, 1}, std::cerr)) return 1;
+    if (!setSceneTime(g, Time{o.clock, o.frame}, std::cerr)) return 1;
     const auto start = std::chrono::steady_clock::now();
     ExpansionCount count;
     try {
@@ -83,6 +84,7 @@ void addStatsCommand(CLI::App& app, int& status) {
         "the memory the graph saves, counted without building the tree");
     st->add_option("scene", s->scene, "The .pcsg file (- reads standard input)")->required();
     addClockOption(st, s->clock);
+    addFrameOption(st, s->frame);
     st->add_flag("--json", s->json, "Print the figures as JSON");
     st->add_option("--max-visits", s->maxVisits,
                    "Work limit of the counting pass in graph-node visits (stochastic systems "

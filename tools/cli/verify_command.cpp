@@ -53,10 +53,17 @@ struct VerifyOptions : VerifySettings {
     std::string clockRange;
     bool cyclic = false;
     bool allFrames = false;
-    // The arguments that pass --clock on to render and export-pov (none without it).
+    int frame = 1;  // a frame of --frames: its number, passed on with its clock
+    // The arguments that pass --clock (and --frame) on to render, export-pov and stats
+    // (none for a still at clock 0).
     std::vector<std::string> clockArgs() const {
-        if (clock == 0) return {};
-        return {"--clock", fmt::format("{}", clock)};
+        std::vector<std::string> args;
+        if (clock != 0) args = {"--clock", fmt::format("{}", clock)};
+        if (frame != 1) {
+            args.push_back("--frame");
+            args.push_back(std::to_string(frame));
+        }
+        return args;
     }
 };
 
@@ -347,6 +354,7 @@ void verifySceneFrames(const std::string& scene, VerifyOptions o, const FramePla
         std::string dirKey = scene;
         if (!frames.empty()) {
             o.clock = frameClock(plan, frames[i]);
+            o.frame = frames[i];
             dirKey = fmt::format("{}_frame{}", fs::path(scene).stem().string(), frames[i]);
         }
         SceneResult r = verifyScene(scene, reportDirName(dirKey, dirs), o, root);
