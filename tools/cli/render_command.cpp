@@ -1,6 +1,6 @@
 // pcsg render SCENE -o OUT [--width W] [--height H] [--aa N] [--adaptive T] [--threads N]
-//                          [--clock X | --frames N [--clock-range A,B] [--cyclic]
-//                          [--subset F,L]] [--json]
+//                          [--clock X [--frame F] | --frames N [--clock-range A,B] [--cyclic]
+//                          [--subset F,L] [--fps R] [--keep-frames]] [--json]
 // Ray traces the scene's cyclic graph directly (tracer/): the graph is never expanded.
 // Prints the figures of the paper's Table 1 and more (tools/cli/stats.h).
 //
@@ -13,7 +13,8 @@
 //
 // With --frames N the scene compiles once and each frame sets its time (frames.h) and is
 // rendered and written exactly as a still at that time would be; a run-time error at frame
-// k names the frame and the clock and keeps the frames written before it.
+// k names the frame and the clock and keeps the frames written before it. A video (-o
+// OUT.mp4, .webm, .gif) is such a sequence of PNG files encoded by ffmpeg (video.h).
 //
 // Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
 // run-time error of docs/language.md, reported once with its module path; no image is
