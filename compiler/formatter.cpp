@@ -18,31 +18,13 @@ namespace {
 constexpr char kBreak = '\x01';      // where a long statement may break: after an operator
 constexpr char kBreakCalc = '\x04';  // after a C-node's `;`: only when its operand is too long
 
-// The precedence level of a binary operator (parser.cpp's table; `=` of a notation-B
-// condition is stored as Eq).
+// The precedence level of a binary operator: the parser's (`=` of a notation-B condition
+// is stored as Eq).
 int level(Tok k) {
-    switch (k) {
-        case Tok::OrOr:
-            return 1;
-        case Tok::AndAnd:
-            return 2;
-        case Tok::Eq:
-        case Tok::Ne:
-            return 3;
-        case Tok::Lt:
-        case Tok::Le:
-        case Tok::Gt:
-        case Tok::Ge:
-            return 4;
-        case Tok::Plus:
-        case Tok::Minus:
-            return 5;
-        default:
-            return 6;
-    }
+    return binaryPrecedence(k, true);
 }
 constexpr int kAtom = 99;
-constexpr int kAdditive = 5;
+const int kAdditive = binaryPrecedence(Tok::Plus, false);
 
 // Concatenation without `"literal" + std::string` (GCC 12 warns -Wrestrict on it).
 std::string cat(std::initializer_list<std::string_view> parts) {

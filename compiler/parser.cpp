@@ -10,6 +10,34 @@
 
 namespace pcsg {
 
+int binaryPrecedence(Tok k, bool assignIsEq) {
+    switch (k) {
+        case Tok::OrOr:
+            return 1;
+        case Tok::AndAnd:
+            return 2;
+        case Tok::Eq:
+        case Tok::Ne:
+            return 3;
+        case Tok::Assign:
+            return assignIsEq ? 3 : 0;
+        case Tok::Lt:
+        case Tok::Le:
+        case Tok::Gt:
+        case Tok::Ge:
+            return 4;
+        case Tok::Plus:
+        case Tok::Minus:
+            return 5;
+        case Tok::Star:
+        case Tok::Slash:
+        case Tok::Percent:
+            return 6;
+        default:
+            return 0;
+    }
+}
+
 namespace {
 
 struct Abort {};  // thrown on a syntax error: unwinds to the statement level
@@ -90,36 +118,7 @@ bool isDirective(Kw k) {
     return k >= Kw::Camera && k <= Kw::Settings;
 }
 
-// Binary operator precedence, loosest 1 to tightest 6; 0: not a binary operator.
-// ('^' and the unary operators are handled by their own functions.)
-int precedence(Tok k, bool assignIsEq) {
-    switch (k) {
-        case Tok::OrOr:
-            return 1;
-        case Tok::AndAnd:
-            return 2;
-        case Tok::Eq:
-        case Tok::Ne:
-            return 3;
-        case Tok::Assign:
-            return assignIsEq ? 3 : 0;
-        case Tok::Lt:
-        case Tok::Le:
-        case Tok::Gt:
-        case Tok::Ge:
-            return 4;
-        case Tok::Plus:
-        case Tok::Minus:
-            return 5;
-        case Tok::Star:
-        case Tok::Slash:
-        case Tok::Percent:
-            return 6;
-        default:
-            return 0;
-    }
-}
-constexpr int kAdditive = 5;
+const int kAdditive = binaryPrecedence(Tok::Plus, false);
 
 class Parser {
   public:
@@ -646,7 +645,7 @@ class Parser {
         for (;;) {
             if (at(Tok::Assign) && !assignIsEq_)
                 fail(p_, "'=' assigns only inside a C-node '{...}'; to compare, write '=='");
-            const int prec = precedence(tok().kind, assignIsEq_);
+            const int prec = binaryPrecedence(tok().kind, assignIsEq_);
             if (prec == 0 || prec < minPrec) break;
             ChainItem item;
             item.op = tok().kind == Tok::Assign ? Tok::Eq : tok().kind;

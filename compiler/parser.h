@@ -20,4 +20,9 @@ inline constexpr uint32_t kMaxRuleNumber = 1000000;
 // AST.
 Ast parse(const Source& src, const TokenStream& tokens, Diagnostics& diags);
 
+// Binary operator precedence, loosest 1 to tightest 6; 0: not a binary operator. `=` is
+// `==` in a notation-B condition (assignIsEq). ('^' and the unary operators have their
+// own parse functions.) The formatter uses the same table to place parentheses.
+int binaryPrecedence(Tok k, bool assignIsEq);
+
 }  // namespace pcsg
