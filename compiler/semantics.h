@@ -125,12 +125,8 @@ class Semantics {
     // (torus 2, triangle 9, tri1/tri2 and the solids without arguments 0).
     uint32_t primitiveArgs(NodeId n, const PathState& s, double* out) const;
 
-    // Constant T-node chains: where the chain starting at T-node n leads (kNone when n is
-    // not a constant T-node), and its product and inverse.
-    NodeId fusedTarget(NodeId n) const { return fused_[n].target; }
-    const Affine& fusedForward(NodeId n) const { return fused_[n].forward; }
-    const Affine& fusedInverse(NodeId n) const { return fused_[n].inverse; }
-    // The graph nodes one step from n passes: the T-nodes of a fused chain, else 1.
+    // The graph nodes one step from n passes: the T-nodes of a fused chain of constant
+    // T-nodes, else 1.
     uint32_t nodesInStep(NodeId n) const {
         return fused_[n].target == kNone ? 1 : fused_[n].length;
     }
