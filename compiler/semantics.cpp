@@ -5,6 +5,10 @@
 
 namespace pcsg {
 
+namespace {
+constexpr uint32_t kMaxFused = 64;  // T-nodes fused into one step at most
+}  // namespace
+
 Semantics::Semantics(const Graph& g)
     : g_(g), maxDepth_(g.scene.settings.maxDepth), fused_(g.nodes.size()) {
     const size_t n = g.nodes.size();
@@ -14,13 +18,14 @@ Semantics::Semantics(const Graph& g)
     for (NodeId m = 0; m < n; ++m) {
         if (!constantT(m)) continue;
         // The chain of constant T-nodes below m: M_m M_c1 ... M_ck, and its inverse
-        // M_ck^-1 ... M_c1^-1 M_m^-1.
+        // M_ck^-1 ... M_c1^-1 M_m^-1. A chain is cut after kMaxFused nodes (the next step
+        // fuses the rest), so that a graph of one long chain is prepared in linear time.
         Fused& f = fused_[m];
         f.forward = g.transforms[g.nodes[m].payload].matrix;
         f.inverse = f.forward.inverse();
         f.forward = Affine::identity() * f.forward;
         NodeId c = g.child(m);
-        for (size_t guard = 0; constantT(c) && guard < n; ++guard) {
+        for (uint32_t k = 1; constantT(c) && k < kMaxFused; ++k) {
             const Affine& mc = g.transforms[g.nodes[c].payload].matrix;
             f.forward = f.forward * mc;
             f.inverse = mc.inverse() * f.inverse;
