@@ -133,6 +133,8 @@ bool renderPovraySide(SceneResult& r, const VerifyOptions& o, const fs::path& po
                       const fs::path& work) {
     std::vector<std::string> povArgs = {"-A"};
     if (o.threads > 0) povArgs.push_back("+WT" + std::to_string(o.threads));
+    // A hand-written file (--pov) may read POV-Ray's own clock: it gets the frame's.
+    if (!o.povFile.empty()) povArgs.push_back(fmt::format("+K{}", o.clock));
     const RenderRun povray = renderPovray(pov.string(), (work / "povray_full.png").string(),
                                           o.width * o.ss, o.height * o.ss, povArgs);
     if (!povray.ok) {
@@ -456,7 +458,9 @@ void addVerifyCommand(CLI::App& app, int& status) {
                   "A cyclic animation (POV-Ray's +KC): the clock steps by (B-A)/N")
         ->needs(frames);
     cmd->add_flag("--all-frames", o->allFrames, "Compare every frame of the N")->needs(frames);
-    cmd->add_option("--pov", o->povFile, "Render this POV-Ray file instead of exporting the scene");
+    cmd->add_option("--pov", o->povFile,
+                    "Render this POV-Ray file instead of exporting the scene (a hand-written "
+                    "scene to compare with); POV-Ray gets each frame's clock as +K");
     cmd->add_option("--pixel-threshold", o->thresholds.pixelOff,
                     "A pixel is off when a channel differs by more than this (0..1)")
         ->capture_default_str();
