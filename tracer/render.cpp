@@ -216,7 +216,7 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
     const auto t0 = Clock::now();
     BoundsOptions boundsOptions;
     boundsOptions.time = opt.boundsTime;
-    Bounds bounds = computeBounds(g, boundsOptions);
+    Bounds bounds = opt.bounds ? *opt.bounds : computeBounds(g, boundsOptions);
     result.infiniteBoxes = bounds.infiniteNodes;
     const auto t1 = Clock::now();
     result.boundsSeconds = std::chrono::duration<double>(t1 - t0).count();

@@ -22,10 +22,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "bounds.h"
 #include "graph.h"
 #include "instance_boxes.h"
 
@@ -41,6 +43,9 @@ struct RenderOptions {
     // The times the hyper-bounding boxes are computed for; none: the graph's time alone.
     // (The image is the same either way: a wider range only culls less.)
     std::optional<TimeRange> boundsTime;
+    // Boxes computed beforehand (a sequence's, once for its whole clock range), used
+    // instead of computing them here; null: computed here, for boundsTime.
+    std::shared_ptr<const Bounds> bounds;
     // Exact boxes of S-node instances where the static ones are loose (instance_boxes.h),
     // kept in a table of at most this many bytes.
     bool instanceBoxes = true;

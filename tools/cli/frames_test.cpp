@@ -103,6 +103,28 @@ TEST(Frames, AFrameAloneIsTheFrameInTheSequence) {
     EXPECT_EQ(j["frames"][6]["clock"].get<double>(), 0.9);
 }
 
+// The sequence's boxes hold for its whole clock range; a frame may compute tighter ones
+// of its own. Either way the pixels are the same, and --json says which a frame used.
+TEST(Frames, RangeBoxesAndFrameBoxesGiveTheSamePixels) {
+    TempDir dir;
+    const std::string scene = dir.write("m.pcsg", kMoving);
+    std::vector<nlohmann::json> runs;
+    for (const char* mode : {"on", "off"}) {
+        const std::string out = dir.file(std::string(mode) + ".png");
+        const ChildResult r = pcsg(
+            small({"render", scene, "-o", out, "--frames", "4", "--frame-bounds", mode, "--json"}));
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        runs.push_back(nlohmann::json::parse(r.out));
+        EXPECT_GE(runs.back()["totals"]["range_bounds_seconds"].get<double>(), 0);
+        for (const auto& f : runs.back()["frames"])
+            EXPECT_EQ(f["bounds"], std::string(mode) == "on" ? "frame" : "range");
+    }
+    for (int f = 0; f < 4; ++f) {
+        const std::string on = runs[0]["frames"][f]["output"], off = runs[1]["frames"][f]["output"];
+        EXPECT_EQ(readFile(on), readFile(off)) << "frame " << f + 1;
+    }
+}
+
 TEST(Frames, SubsetAndCyclicPickTheirFrames) {
     TempDir dir;
     const std::string scene = dir.write("m.pcsg", kMoving);
