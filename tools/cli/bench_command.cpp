@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "bench_animation.h"
 #include "commands.h"
 #include "renders.h"
 #include "stats.h"
@@ -39,6 +40,10 @@ struct BenchOptions {
     bool nativeOnly = false;
     std::string markdown;  // append the table to this file
     uint64_t maxNodes = 10'000'000;
+    // The animation row: frames of animationScene (0: none). By default 48 with the
+    // default scene set, none when scenes are named.
+    std::optional<int> animationFrames;
+    std::string animationScene = std::string(PCSG_SOURCE_DIR) + "/scenes/growing_tree.pcsg";
 };
 
 // What pcsg-embree measured on a triangle-only scene: its own build and trace times and
@@ -292,6 +297,61 @@ std::string targetsText(const std::vector<Target>& targets) {
     return t.empty() ? t : "\nTargets:\n" + t;
 }
 
+// The animation targets: at least 3x less total time than POV-Ray on the exported frames,
+// and at most 1/10 of its peak RSS.
+std::vector<Target> animationTargets(const std::optional<AnimationRow>& a) {
+    if (!a || !a->nativeOk || !a->povOk) return {};
+    const double time = a->povSeconds() / std::max(a->nativeSeconds, 1e-9);
+    const double rss = double(a->povRss) / double(std::max<uint64_t>(a->nativeRss, 1));
+    return {{fmt::format("{} frames of {} in at least 3x less time than POV-Ray ({:.2f}x)",
+                         a->frames, a->scene, time),
+             time >= 3},
+            {fmt::format("{} frames of {} at most 1/10 of POV-Ray's peak RSS (1/{:.1f})", a->frames,
+                         a->scene, rss),
+             rss >= 10}};
+}
+
+// The animation's table: both whole commands.
+std::string animationTable(const AnimationRow& a) {
+    std::string t =
+        "\n| animation | frames | native (one command) | export + POV-Ray (one command) | "
+        "POV-Ray / native | native peak RSS | POV-Ray peak RSS | RSS ratio |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+    const std::string native = a.nativeOk ? fmt::format("{:.2f} s", a.nativeSeconds) : "failed";
+    std::string pov = "-", ratio = "-", povRss = "-", rssRatio = "-";
+    if (a.povOk) {
+        pov = fmt::format("{:.2f} s + {:.2f} s", a.exportSeconds, a.povraySeconds);
+        ratio = fmt::format("{:.2f}", a.povSeconds() / std::max(a.nativeSeconds, 1e-9));
+        povRss = humanBytes(a.povRss);
+        rssRatio =
+            fmt::format("{:.1f}", double(a.povRss) / double(std::max<uint64_t>(a.nativeRss, 1)));
+    } else if (!a.note.empty()) {
+        pov = a.note.substr(0, a.note.find('\n'));
+    }
+    t += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", a.scene, a.frames, native, pov,
+                     ratio, a.nativeOk ? humanBytes(a.nativeRss) : "-", povRss, rssRatio);
+    return t + targetsText(animationTargets(a));
+}
+
+nlohmann::json animationJson(const AnimationRow& a) {
+    nlohmann::json j = {{"scene", a.scene},
+                        {"frames", a.frames},
+                        {"native_ok", a.nativeOk},
+                        {"povray_ok", a.povOk}};
+    if (a.nativeOk) j["native_seconds"] = a.nativeSeconds, j["native_peak_rss_bytes"] = a.nativeRss;
+    if (a.povOk) {
+        j["export_seconds"] = a.exportSeconds;
+        j["povray_seconds"] = a.povraySeconds;
+        j["povray_peak_rss_bytes"] = a.povRss;
+    }
+    if (!a.note.empty()) j["note"] = a.note;
+    nlohmann::json targets = nlohmann::json::array();
+    for (const Target& t : animationTargets(a))
+        targets.push_back({{"target", t.what}, {"met", t.met}});
+    j["targets"] = targets;
+    return j;
+}
+
 // One row of the table, without the Embree columns.
 std::string tableRow(const BenchRow& r) {
     const std::string prims = r.primitives ? fmt::format("{}", *r.primitives) : "-";
@@ -375,8 +435,45 @@ nlohmann::json jsonOf(const std::vector<BenchRow>& rows, const BenchOptions& o) 
             {"targets", targets}};
 }
 
+// The animation row, when the options ask for one.
+std::optional<AnimationRow> animationRow(const BenchOptions& o, const fs::path& work) {
+    const int frames = o.animationFrames.value_or(o.scenes.empty() ? 48 : 0);
+    if (frames <= 0) return std::nullopt;
+    if (!o.json) std::cerr << "bench: " << frames << " frames of " << o.animationScene << " ...\n";
+    AnimationBenchOptions a;
+    a.scene = o.animationScene;
+    a.frames = frames;
+    a.width = o.width;
+    a.height = o.height;
+    a.adaptive = o.adaptive;
+    a.threads = o.threads;
+    a.nativeOnly = o.nativeOnly;
+    return benchAnimation(a, work);
+}
+
+int printBench(const std::vector<BenchRow>& rows, const std::optional<AnimationRow>& animation,
+               const BenchOptions& o) {
+    std::string table = tableOf(rows, o);
+    if (animation) table += animationTable(*animation);
+    if (o.json) {
+        nlohmann::json j = jsonOf(rows, o);
+        if (animation) j["animation"] = animationJson(*animation);
+        std::cout << j.dump(2) << "\n";
+    } else {
+        std::cout << table;
+    }
+    if (!o.markdown.empty()) {
+        std::ofstream out(o.markdown, std::ios::app);
+        out << "\n" << table;
+        if (!out) {
+            std::cerr << "pcsg bench: cannot write " << o.markdown << "\n";
+            return 2;
+        }
+    }
+    return 0;
+}
+
 int runBench(BenchOptions o) {
-    if (o.scenes.empty()) o.scenes = defaultScenes();
     if (!o.nativeOnly && !inPath("povray")) {
         std::cerr << "pcsg bench: " << kPovrayInstallHint << " (or use --native-only)\n";
         return 2;
@@ -390,25 +487,16 @@ int runBench(BenchOptions o) {
     const std::optional<std::string> embree = findEmbree();
     std::vector<BenchRow> rows;
     int status = 0;
-    for (const auto& scene : o.scenes) {
+    for (const auto& scene : o.scenes.empty() ? defaultScenes() : o.scenes) {
         if (!o.json) std::cerr << "bench: " << scene << " ...\n";
         rows.push_back(benchScene(scene, o, work, embree));
         if (!rows.back().nativeOk) status = 1;
     }
+    const std::optional<AnimationRow> animation = animationRow(o, work);
+    if (animation && !animation->nativeOk) status = 1;
     std::error_code ec;
     fs::remove_all(work, ec);
-    if (o.json)
-        std::cout << jsonOf(rows, o).dump(2) << "\n";
-    else
-        std::cout << tableOf(rows, o);
-    if (!o.markdown.empty()) {
-        std::ofstream out(o.markdown, std::ios::app);
-        out << "\n" << tableOf(rows, o);
-        if (!out) {
-            std::cerr << "pcsg bench: cannot write " << o.markdown << "\n";
-            return 2;
-        }
-    }
+    if (const int printed = printBench(rows, animation, o)) return printed;
     return status;
 }
 
@@ -422,10 +510,11 @@ void addBenchCommand(CLI::App& app, int& status) {
         "and print both times, their ratio, rays per second, both peak RSS values and the\n"
         "primitive equivalence (peak RSS of each whole render command), then which targets are\n"
         "met. Without scenes: the Sierpinski tetrahedron at orders 6, 8, 9, 10 and 12, the\n"
-        "sympodial tree and the terrain. When pcsg-embree is beside pcsg (built when Embree 3\n"
-        "is found), triangle-only scenes are also traced by Embree on the expanded mesh, the\n"
-        "yardstick. Microbenchmarks of the hot paths are the separate pcsg_microbench program\n"
-        "(Google Benchmark).");
+        "sympodial tree and the terrain, then 48 frames of the growing tree (one `pcsg render\n"
+        "--frames` command against one `povray` command on the exported frames' .ini). When\n"
+        "pcsg-embree is beside pcsg (built when Embree 3 is found), triangle-only scenes are\n"
+        "also traced by Embree on the expanded mesh, the yardstick. Microbenchmarks\n"
+        "of the hot paths are the separate pcsg_microbench program (Google Benchmark).");
     cmd->add_option("scenes", o->scenes, "Scene files (.pcsg)");
     cmd->add_option("--width", o->width, "Image width")
         ->capture_default_str()
@@ -445,6 +534,13 @@ void addBenchCommand(CLI::App& app, int& status) {
     cmd->add_flag("--native-only", o->nativeOnly, "Render natively only (no POV-Ray, no Embree)");
     cmd->add_option("--markdown", o->markdown,
                     "Append the table, with date and machine, to this file");
+    cmd->add_option("--animation-frames", o->animationFrames,
+                    "Frames of the animation row (default: 48 with the default scenes, none "
+                    "when scenes are named; 0: none)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--animation-scene", o->animationScene, "The animated scene of that row")
+        ->capture_default_str()
+        ->check(CLI::ExistingFile);
     cmd->add_flag("--json", o->json, "Print the results as JSON");
     cmd->callback([o, &status] { status = runBench(*o); });
 }

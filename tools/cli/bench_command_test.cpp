@@ -59,6 +59,36 @@ TEST(BenchCommand, SideBySideTableWithDateMachineAndTargets) {
     EXPECT_EQ(readFile(md).substr(0, table.size()), table);
 }
 
+// The animation row: one `pcsg render --frames` command against POV-Ray on the exported
+// frames, with both whole commands' time and peak RSS and the two animation targets.
+TEST(BenchCommand, AnimationRowRendersEveryFrameBothWays) {
+    if (!inPath("povray")) GTEST_SKIP() << "povray is not installed";
+    const std::string scene = std::string(PCSG_SOURCE_DIR) + "/tests/scenes/clock_probe.pcsg";
+    TempDir dir;
+    const std::string a = dir.write("sierpinski_8.pcsg", testing::kSierpinskiA);
+    const ChildResult r = pcsg({"bench", "--json", "--width", "32", "--height", "24", "--threads",
+                                "2", "--animation-frames", "3", "--animation-scene", scene, a});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(j.contains("animation")) << r.out;
+    const auto& anim = j["animation"];
+    EXPECT_EQ(anim["scene"], "clock_probe");
+    EXPECT_EQ(anim["frames"], 3);
+    EXPECT_EQ(anim["native_ok"], true) << r.out;
+    EXPECT_EQ(anim["povray_ok"], true) << r.out;
+    EXPECT_GT(anim["native_peak_rss_bytes"].get<double>(), 1e6);
+    EXPECT_GT(anim["povray_peak_rss_bytes"].get<double>(), 1e6);
+    EXPECT_GT(anim["povray_seconds"].get<double>(), 0);
+    ASSERT_EQ(anim["targets"].size(), 2u);
+    EXPECT_NE(anim["targets"][0]["target"].get<std::string>().find("3 frames of clock_probe"),
+              std::string::npos);
+    // Named scenes without --animation-frames: no animation row.
+    const ChildResult plain =
+        pcsg({"bench", "--json", "--native-only", "--width", "16", "--height", "12", a});
+    ASSERT_EQ(plain.exitCode, 0) << plain.err;
+    EXPECT_FALSE(nlohmann::json::parse(plain.out).contains("animation"));
+}
+
 // With pcsg-embree beside pcsg (built when Embree 3 is found), a triangle-only scene gets
 // Embree's figures and the yardstick targets; a scene with other primitives does not.
 TEST(BenchCommand, EmbreeColumnsForTriangleOnlyScenes) {
