@@ -317,7 +317,9 @@ int renderFrame(const RenderCommandOptions& o, const FramePlan& plan, int f, Gra
         std::cerr << "pcsg render: " << error << note << "\n";
         return 2;
     }
-    report.result.rgb = {};
+    // Releases the pixels: `= {}` would clear them but keep their memory, a whole image
+    // per frame held to the end of the sequence.
+    report.result.rgb = std::vector<float>();
     out.output = fo.output;
     out.result = std::move(report.result);
     out.imageWriteSeconds = report.imageWriteSeconds;
@@ -503,7 +505,7 @@ int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
         std::cerr << "pcsg render: " << error << "\n";
         return 2;
     }
-    report.result.rgb = {};  // written: the printing needs only the figures
+    report.result.rgb = std::vector<float>();  // written: the printing needs only the figures
     report.graphNodes = g.nodes.size();
     Stats& s = report.stats;
     s.scene = o.scene;
