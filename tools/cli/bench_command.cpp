@@ -21,7 +21,9 @@
 #include <thread>
 
 #include "bench_animation.h"
+#include "bench_plot.h"
 #include "commands.h"
+#include "embree_run.h"
 #include "renders.h"
 #include "stats.h"
 
@@ -43,16 +45,9 @@ struct BenchOptions {
     // The animation row: frames of animationScene (0: none). By default 48 with the
     // default scene set, none when scenes are named.
     std::optional<int> animationFrames;
+    std::string plot;  // --plot FILE: the scaling sweep instead of the table
+    std::vector<int> plotOrders = {4, 16};
     std::string animationScene = std::string(PCSG_SOURCE_DIR) + "/scenes/growing_tree.pcsg";
-};
-
-// What pcsg-embree measured on a triangle-only scene: its own build and trace times and
-// rays per second, and the whole command's wall time and peak RSS (wait4).
-struct EmbreeRun {
-    uint64_t triangles = 0;
-    double buildSeconds = 0, traceSeconds = 0, raysPerSecond = 0;
-    double seconds = 0;  // the whole command: compiling, expanding, building and tracing
-    uint64_t peakRss = 0;
 };
 
 struct BenchRow {
@@ -103,38 +98,6 @@ std::string today() {
     return buf;
 }
 
-// pcsg-embree beside this executable, or nothing (then bench has no Embree columns).
-std::optional<std::string> findEmbree() {
-    const fs::path self = selfExecutable();
-    if (!self.has_parent_path()) return std::nullopt;
-    const fs::path beside = self.parent_path() / "pcsg-embree";
-    if (access(beside.c_str(), X_OK) != 0) return std::nullopt;
-    return beside.string();
-}
-
-// Embree on the scene's expanded mesh at the bench's size and thread count: one camera ray
-// per pixel centre and a shadow ray per hit and light. Nothing when the scene is not
-// triangle-only (exit status 2) or Embree could not trace it (over --max-nodes, say).
-std::optional<EmbreeRun> runEmbree(const std::string& embree, const std::string& scene,
-                                   const BenchOptions& o) {
-    const int threads = o.threads > 0 ? o.threads : int(std::thread::hardware_concurrency());
-    const ChildResult c =
-        runChild({embree, scene, "--json", "--width", std::to_string(o.width), "--height",
-                  std::to_string(o.height), "--threads", std::to_string(std::max(threads, 1)),
-                  "--max-nodes", std::to_string(o.maxNodes)});
-    if (c.exitCode != 0) return std::nullopt;
-    const auto j = nlohmann::json::parse(c.out, nullptr, false);
-    if (!j.is_object()) return std::nullopt;
-    EmbreeRun e;
-    e.triangles = j.value("triangles", uint64_t{0});
-    e.buildSeconds = j.value("build_seconds", 0.0);
-    e.traceSeconds = j.value("trace_seconds", 0.0);
-    e.raysPerSecond = j.value("rays_per_second", 0.0);
-    e.seconds = c.seconds;
-    e.peakRss = c.peakRssBytes;
-    return e;
-}
-
 BenchRow benchScene(const std::string& scene, const BenchOptions& o, const fs::path& work,
                     const std::optional<std::string>& embree) {
     BenchRow row;
@@ -159,7 +122,7 @@ BenchRow benchScene(const std::string& scene, const BenchOptions& o, const fs::p
     row.raysPerSecond = jsonField<double>(native.json, "rays_per_second");
     row.primitives = jsonField<uint64_t>(native.json, "primitive_equivalence");
     if (o.nativeOnly) return row;
-    if (embree) row.embree = runEmbree(*embree, scene, o);
+    if (embree) row.embree = runEmbree(*embree, scene, o.width, o.height, o.threads, o.maxNodes);
 
     const fs::path pov = work / (row.scene + ".pov");
     const RenderRun exported = exportPov(scene, pov.string(), o.width, o.height,
@@ -473,6 +436,49 @@ int printBench(const std::vector<BenchRow>& rows, const std::optional<AnimationR
     return 0;
 }
 
+// --plot FILE: the Sierpinski sweep, its table (or JSON) and the SVG.
+int runPlot(const BenchOptions& o, const fs::path& work) {
+    if (o.plotOrders[0] > o.plotOrders[1]) {
+        std::cerr << "pcsg bench: --plot-orders A,B needs A <= B\n";
+        return 2;
+    }
+    ScalingOptions so;
+    so.fromOrder = o.plotOrders[0];
+    so.toOrder = o.plotOrders[1];
+    so.width = o.width;
+    so.height = o.height;
+    so.adaptive = o.adaptive;
+    so.threads = o.threads;
+    so.maxNodes = std::max<uint64_t>(o.maxNodes, 20'000'000);
+    const std::vector<ScalingPoint> points = measureScaling(so, work, std::cerr);
+    const std::string caption =
+        fmt::format("pcsg bench --plot, {}, {}: {}x{}, +A{}, each renderer's whole command",
+                    today(), machine(), o.width, o.height, o.adaptive);
+    std::ofstream out(o.plot, std::ios::trunc);
+    out << scalingSvg(points, caption);
+    if (!out) {
+        std::cerr << "pcsg bench: cannot write " << o.plot << "\n";
+        return 2;
+    }
+    nlohmann::json j = nlohmann::json::array();
+    std::string t = "| order | pcsg | POV-Ray | Embree |\n|---:|---:|---:|---:|\n";
+    for (const ScalingPoint& p : points) {
+        auto cell = [&](int r) {
+            return p.seconds[r] ? fmt::format("{:.2f} s, {}", *p.seconds[r], humanBytes(*p.rss[r]))
+                                : std::string("-");
+        };
+        t += fmt::format("| {} | {} | {} | {} |\n", p.order, cell(0), cell(1), cell(2));
+        nlohmann::json e = {{"order", p.order}};
+        const char* keys[3] = {"native", "povray", "embree"};
+        for (int r = 0; r < 3; ++r)
+            if (p.seconds[r])
+                e[keys[r]] = {{"seconds", *p.seconds[r]}, {"peak_rss_bytes", *p.rss[r]}};
+        j.push_back(e);
+    }
+    std::cout << (o.json ? j.dump(2) + "\n" : t + "wrote " + o.plot + "\n");
+    return 0;
+}
+
 int runBench(BenchOptions o) {
     if (!o.nativeOnly && !inPath("povray")) {
         std::cerr << "pcsg bench: " << kPovrayInstallHint << " (or use --native-only)\n";
@@ -484,6 +490,12 @@ int runBench(BenchOptions o) {
         return 2;
     }
     const fs::path work = tmpl;
+    if (!o.plot.empty()) {
+        const int status = runPlot(o, work);
+        std::error_code ec;
+        fs::remove_all(work, ec);
+        return status;
+    }
     const std::optional<std::string> embree = findEmbree();
     std::vector<BenchRow> rows;
     int status = 0;
@@ -541,6 +553,16 @@ void addBenchCommand(CLI::App& app, int& status) {
     cmd->add_option("--animation-scene", o->animationScene, "The animated scene of that row")
         ->capture_default_str()
         ->check(CLI::ExistingFile);
+    cmd->add_option("--plot", o->plot,
+                    "Instead of the table: render the Sierpinski tetrahedron at each order of "
+                    "--plot-orders with pcsg, POV-Ray (on the export) and Embree (on the mesh, "
+                    "when pcsg-embree is built), each until its memory would pass half the "
+                    "machine's, and draw time and peak RSS against the order into this SVG");
+    cmd->add_option("--plot-orders", o->plotOrders, "A,B: the orders of --plot")
+        ->delimiter(',')
+        ->expected(2)
+        ->capture_default_str()
+        ->check(CLI::Range(1, 20));
     cmd->add_flag("--json", o->json, "Print the results as JSON");
     cmd->callback([o, &status] { status = runBench(*o); });
 }
