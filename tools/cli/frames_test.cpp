@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli_test_util.h"
+#include "sanitizer.h"
 
 namespace pcsg::tools {
 namespace {
@@ -95,7 +96,9 @@ TEST(Frames, AFrameAloneIsTheFrameInTheSequence) {
     for (const auto& f : j["frames"]) {
         const std::string clock = nlohmann::json(f["clock"].get<double>()).dump();
         const std::string alone = dir.file("alone.png");
-        const ChildResult a = pcsg(small({"render", scene, "-o", alone, "--clock", clock}));
+        // Alone on one thread, where the sequence ran on two: the same bytes.
+        const ChildResult a = pcsg({"render", scene, "-o", alone, "--clock", clock, "--width", "40",
+                                    "--height", "30", "--threads", "1"});
         ASSERT_EQ(a.exitCode, 0) << a.err;
         EXPECT_EQ(readFile(alone), readFile(f["output"].get<std::string>()))
             << "frame " << f["frame"] << " at clock " << clock;
@@ -129,6 +132,7 @@ TEST(Frames, RangeBoxesAndFrameBoxesGiveTheSamePixels) {
 // with its length (it once kept every frame's image to the end, 177 MB for 48 frames of
 // 640x480).
 TEST(Frames, ASequenceHoldsOneImageAtATime) {
+    if (kAddressSanitizer) GTEST_SKIP() << "ASan's quarantine keeps freed memory resident";
     TempDir dir;
     const std::string scene = dir.write("m.pcsg", kMoving);
     auto peak = [&](const char* subset) {

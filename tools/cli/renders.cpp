@@ -92,6 +92,11 @@ RenderRun renderPovray(const std::string& pov, const std::string& out, int width
                                      "-V"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     r.child = runChild(argv);
+    // POV-Ray 3.7 gives up when its worker thread is slow to start on a busy machine: that
+    // is no verdict on the scene, so it gets one more try.
+    if (r.child.exitCode != 0 &&
+        r.child.err.find("Timed out waiting for worker thread startup") != std::string::npos)
+        r.child = runChild(argv);
     if (!r.child.started) {
         r.error = kPovrayInstallHint;
         return r;
