@@ -109,6 +109,45 @@ TEST(PovWriter, EachMaterialIsDeclaredOnceAsATexture) {
     EXPECT_EQ(occurrences(s, "texture{M0}"), 1u);
 }
 
+// Section 10's finish items are written where they differ from POV-Ray's defaults; a
+// material with an interior makes every material a POV-Ray `material`, so that the
+// interior travels with its texture.
+TEST(PovWriter, FinishItemsAndInteriors) {
+    Graph g;
+    defaultScene(g);
+    Material glass;
+    glass.name = "glass";
+    glass.brilliance = 2;
+    glass.specular = 0.5;
+    glass.roughness = 0.01;
+    glass.metallic = 0.25;
+    glass.reflectionRange = true;
+    glass.reflectionMin = 0.05;
+    glass.reflection = 0.9;
+    glass.fresnel = true;
+    glass.reflectMetallic = 1;
+    glass.conserveEnergy = true;
+    glass.interior = true;
+    glass.ior = 1.5;
+    g.materials.push_back(glass);
+    g.axiom =
+        g.addOperator(CsgOp::Union, {paint(g, 1, primitive(g, P::Sphere)), primitive(g, P::Cube)});
+    const std::string s = exportText(g);
+    EXPECT_NE(s.find("#declare M0 = material { texture { pigment { color rgb <1,1,1> } finish { "
+                     "ambient 0.1 diffuse 0.6 phong 0 phong_size 40 reflection 0 } } }"),
+              std::string::npos)
+        << s;
+    EXPECT_NE(s.find("#declare M1 = material { texture { pigment { color rgb <1,1,1> } finish { "
+                     "ambient 0.1 diffuse 0.6 brilliance 2 phong 0 phong_size 40 specular 0.5 "
+                     "roughness 0.01 metallic 0.25 reflection { 0.05, 0.9 fresnel on metallic 1 } "
+                     "conserve_energy } } interior { ior 1.5 } }  // glass"),
+              std::string::npos)
+        << s;
+    EXPECT_EQ(occurrences(s, "material{M1}"), 1u);
+    EXPECT_EQ(occurrences(s, "material{M0}"), 1u);
+    EXPECT_EQ(occurrences(s, "texture{M"), 0u);
+}
+
 TEST(PovWriter, PrimitivesInPovRaysOwnFormWithTheTransposedMatrix) {
     // move(1,2,3) uscale(2): L = 2I, t = (1,2,3).
     const std::string m = " matrix<2,0,0,0,2,0,0,0,2,1,2,3>}";
