@@ -320,9 +320,14 @@ Affine torusFrame() {
 }
 
 // One primitive on one line. Returns false when it was left out.
-bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, const std::string& indent,
-                  bool wrapped) {
-    const auto tex = [&] { o.put(" {}{{M{}}}", wrapped ? "material" : "texture", p.material); };
+// ` texture{M<i>}` (or ` material{M<i>}`) for a node's own texture; nothing without one.
+void putTextureRef(Out& o, uint32_t texture, bool wrapped) {
+    if (texture != kNone) o.put(" {}{{M{}}}", wrapped ? "material" : "texture", texture);
+}
+
+bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_t texture,
+                  const std::string& indent, bool wrapped) {
+    const auto tex = [&] { putTextureRef(o, texture, wrapped); };
     switch (p.kind) {
         case PrimitiveKind::Sphere:
         case PrimitiveKind::Cube:
@@ -376,6 +381,7 @@ struct Item {
     std::vector<std::pair<size_t, size_t>> slices;  // a big group's sub-groups
     bool ownsMembers = false;  // this item pushed members[lo, hi) and pops them at the end
     Box box;
+    uint32_t texture = kNone;  // a group that replaces a union: the union's own texture
 };
 
 class TreeWriter {
@@ -440,6 +446,7 @@ class TreeWriter {
         const Box& b = boxes_[it.node];
         const bool bound = !node.is(CsgOp::Union) || opt_.boundUnions;
         o_.put("{}", indent());
+        putTextureRef(o_, node.texture, wrapped_);
         if (bound && boundable(b)) putBound(o_, b);
         o_.put(" }}\n");
         stack_.pop_back();
@@ -447,7 +454,7 @@ class TreeWriter {
 
     // Writes the primitive of the top item, node n, and pops it.
     void writePrimitive(uint32_t n) {
-        if (putPrimitive(o_, t_, t_.primitiveOf(n), indent(), wrapped_))
+        if (putPrimitive(o_, t_, t_.primitiveOf(n), t_.nodes[n].texture, indent(), wrapped_))
             ++stats_.objects;
         else
             ++stats_.skipped;
@@ -470,6 +477,7 @@ class TreeWriter {
         g.lo = lo;
         g.hi = members_.size();
         g.ownsMembers = true;
+        g.texture = t_.nodes[n].texture;
         stack_.push_back(std::move(g));
     }
 
@@ -478,7 +486,7 @@ class TreeWriter {
     void stepGroup(Item& it) {
         const size_t n = it.hi - it.lo;
         if (it.next == 0) {
-            if (n == 1) {
+            if (n == 1 && it.texture == kNone) {
                 const uint32_t only = members_[it.lo];
                 finishGroup();
                 stack_.push_back(nodeItem(only));
@@ -504,6 +512,7 @@ class TreeWriter {
             return;
         }
         o_.put("{}", indent());
+        putTextureRef(o_, it.texture, wrapped_);
         if (opt_.boundUnions && boundable(it.box)) putBound(o_, it.box);
         o_.put(" }}\n");
         finishGroup();
@@ -517,7 +526,9 @@ class TreeWriter {
             todo.pop_back();
             const uint32_t* c = t_.childrenOf(u);
             for (uint32_t i = 0; i < t_.nodes[u].count; ++i) {
-                if (t_.nodes[c[i]].is(CsgOp::Union))
+                // A union with a texture of its own stays one member: flattened, its
+                // primitives would lose the texture.
+                if (t_.nodes[c[i]].is(CsgOp::Union) && t_.nodes[c[i]].texture == kNone)
                     todo.push_back(c[i]);
                 else
                     members_.push_back(c[i]);
