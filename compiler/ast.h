@@ -99,6 +99,21 @@ struct DirectiveItem {
     uint32_t e[3] = {kNoNode, kNoNode, kNoNode};
 };
 
+// One element of a material's body (docs/language.md sections 7 and 10), which follows
+// POV-Ray's free syntax: a word (`pigment`, `rgb`, `fresnel`, `scale`), a number
+// (an expression), a vector `<a, b, ...>` of 2 to 5 components (Ast::lists holds their
+// expressions), a block `{ ... }` or a bracket `[ ... ]` (its atoms [first, first+count)
+// of Ast::atoms). The builder reads the sequence; separators (`,` `;` line breaks) are
+// not kept.
+enum class AtomKind : uint8_t { Word, Number, Vector, Block, Bracket };
+struct Atom {
+    AtomKind kind;
+    uint32_t tok = 0;               // the first token ('<', '{', '[' for the composites)
+    uint32_t end = 0;               // the last token ('>', '}', ']'; else tok's last)
+    uint32_t expr = kNoNode;        // Number
+    uint32_t first = 0, count = 0;  // Vector: Ast::lists; Block, Bracket: Ast::atoms
+};
+
 struct Stmt {
     StmtKind kind;
     uint32_t tok = 0;               // the first token
@@ -109,7 +124,9 @@ struct Stmt {
     uint32_t expr = kNoNode;        // Module: selection; RuleB: condition (kNoNode: none)
     uint32_t body = kNoNode;        // CsgNode index
     uint32_t first = 0, count = 0;  // RuleB formals (token indices in Ast::lists);
-                                    // Directive items [first, first+count) of Ast::items
+                                    // Directive items [first, first+count) of Ast::items;
+                                    // a material's body: atoms of Ast::atoms
+    uint32_t last = 0;              // a material: its closing '}'
     bool hasFormals = false;        // RuleB: `S(...)` rather than `S`
 };
 
@@ -120,6 +137,7 @@ struct Ast {
     std::vector<CsgNode> csg;
     std::vector<Assign> assigns;
     std::vector<DirectiveItem> items;
+    std::vector<Atom> atoms;
     std::vector<uint32_t> lists;  // operand, argument and formal lists
 
     // What syntax errors left out, so that the builder does not report their echoes:

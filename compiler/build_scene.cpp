@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "build_material.h"
 #include "builder.h"
 
 namespace pcsg {
@@ -21,7 +22,6 @@ class DirectiveReader {
     void camera(const Stmt& s);
     void light(const Stmt& s);
     void background(const Stmt& s);
-    void material(const Stmt& s, const Names& names);
 
   private:
     bool once(uint32_t& seen, const Stmt& s, const char* what);
@@ -219,30 +219,6 @@ void DirectiveReader::background(const Stmt& s) {
     if (auto v = vectorValue(ast_.items[s.first], 0)) g_.scene.background = *v;
 }
 
-void DirectiveReader::material(const Stmt& s, const Names& names) {
-    auto it = names.materialOfName.find(s.nameTok);
-    if (it == names.materialOfName.end()) return;  // a duplicate, reported
-    Material& m = g_.materials[it->second];
-    target(DirectiveTarget::Material, it->second);
-    items(s, "material", "color, ambient, diffuse, phong, phong_size, reflection",
-          [&](std::string_view n, const DirectiveItem& item) {
-              if (n == "color" || n == "colour") {
-                  if (auto v = wantVector(item, 0)) m.color = *v;
-                  return true;
-              }
-              static constexpr const char* kScalars[] = {"ambient", "diffuse", "phong",
-                                                         "phong_size", "reflection"};
-              double* const fields[] = {&m.ambient, &m.diffuse, &m.phong, &m.phongSize,
-                                        &m.reflection};
-              for (uint8_t i = 0; i < 5; ++i) {
-                  if (n != kScalars[i]) continue;
-                  if (auto v = wantScalar(item, static_cast<uint8_t>(3 + i))) *fields[i] = *v;
-                  return true;
-              }
-              return false;
-          });
-}
-
 }  // namespace
 
 void readSettings(BuildContext& ctx, ExprCompiler& exprs) {
@@ -266,7 +242,9 @@ void readDirectives(BuildContext& ctx, const Names& names, ExprCompiler& exprs) 
                 reader.background(s);
                 break;
             case Kw::Material:
-                reader.material(s, names);
+                if (auto it = names.materialOfName.find(s.nameTok);
+                    it != names.materialOfName.end())  // else a duplicate, reported
+                    readMaterial(ctx, exprs, s, it->second);
                 break;
             default:
                 break;

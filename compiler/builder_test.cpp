@@ -465,6 +465,67 @@ TEST(Directives, FillTheSceneAndTheMaterials) {
     EXPECT_EQ(m[1].ambient, 0.1);
 }
 
+// Section 10's blocks inside a material, in POV-Ray's syntax, next to the flat items.
+TEST(Directives, MaterialBlocks) {
+    auto c = compile(
+        "material water {\n"
+        "  pigment { color rgbft <0.3, 0.5, 0.6, 0, 0> }\n"
+        "  normal { }\n"
+        "  finish { ambient 0 diffuse 0.2 brilliance 1.5 phong 0.3 phong_size 60 specular 0.4\n"
+        "           roughness 0.01 metallic reflection { 0.05, 0.9 fresnel on metallic 0.5 }\n"
+        "           conserve_energy }\n"
+        "  interior { ior 1.33 }\n"
+        "}\n"
+        "material flat { colour <1, 0, 0>  reflection 0.25  finish { metallic 0.3 } }\n"
+        "material grey { pigment { rgb 0.5 } finish { reflection { 0.4 } fresnel_off 0 } }\n"
+        "paint(water) sphere ∪ paint(flat) cube ∪ paint(grey) cone\n");
+    ASSERT_FALSE(c->graph);  // fresnel_off is not an item
+    EXPECT_NE(c->errors().find("unknown finish setting 'fresnel_off'"), std::string::npos)
+        << c->errors();
+
+    c = compile(
+        "material water {\n"
+        "  pigment { color rgbft <0.3, 0.5, 0.6, 0, 0> }\n"
+        "  normal { }\n"
+        "  finish { ambient 0 diffuse 0.2 brilliance 1.5 phong 0.3 phong_size 60 specular 0.4\n"
+        "           roughness 0.01 metallic reflection { 0.05, 0.9 fresnel on metallic 0.5 }\n"
+        "           conserve_energy }\n"
+        "  interior { ior 1.33 }\n"
+        "}\n"
+        "material flat { colour <1, 0, 0>  reflection 0.25  finish { metallic 0.3 } }\n"
+        "material grey { pigment { rgb 0.5 } finish { reflection { 0.4 } } }\n"
+        "paint(water) sphere ∪ paint(flat) cube ∪ paint(grey) cone\n");
+    ASSERT_TRUE(c->graph) << c->errors();
+    const auto& m = c->graph->materials;
+    ASSERT_EQ(m.size(), 4u);
+    const Material& w = m[1];
+    EXPECT_EQ(w.color, (Vec3{0.3, 0.5, 0.6}));
+    EXPECT_EQ(w.ambient, 0);
+    EXPECT_EQ(w.diffuse, 0.2);
+    EXPECT_EQ(w.brilliance, 1.5);
+    EXPECT_EQ(w.phong, 0.3);
+    EXPECT_EQ(w.phongSize, 60);
+    EXPECT_EQ(w.specular, 0.4);
+    EXPECT_EQ(w.roughness, 0.01);
+    EXPECT_EQ(w.metallic, 1);
+    EXPECT_TRUE(w.reflectionRange);
+    EXPECT_EQ(w.minReflection(), 0.05);
+    EXPECT_EQ(w.reflection, 0.9);
+    EXPECT_TRUE(w.fresnel);
+    EXPECT_EQ(w.reflectMetallic, 0.5);
+    EXPECT_TRUE(w.conserveEnergy);
+    EXPECT_TRUE(w.interior);
+    EXPECT_EQ(w.ior, 1.33);
+    EXPECT_EQ(m[2].color, (Vec3{1, 0, 0}));
+    EXPECT_EQ(m[2].reflection, 0.25);
+    EXPECT_EQ(m[2].minReflection(), 0.25);
+    EXPECT_EQ(m[2].metallic, 0.3);
+    EXPECT_FALSE(m[2].interior);
+    EXPECT_EQ(m[3].color, (Vec3{0.5, 0.5, 0.5}));
+    EXPECT_FALSE(m[3].reflectionRange);  // one value: the minimum and the maximum
+    EXPECT_EQ(m[3].minReflection(), 0.4);
+}
+
 TEST(Directives, DefaultsWithoutAny) {
     auto c = compile("sphere");
     ASSERT_TRUE(c->graph) << c->errors();

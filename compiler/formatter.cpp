@@ -352,9 +352,12 @@ class Printer {
     std::string directive(const Stmt& s) const {
         std::string head = text(s.tok);
         if (s.directive == Kw::Background) return head + " " + vector(ast_.items[s.first]);
-        if (s.directive == Kw::Material) head += cat({" ", text(s.nameTok)});
         std::vector<Item> list;
-        for (uint32_t k = 0; k < s.count; ++k) {
+        if (s.directive == Kw::Material) {
+            head += cat({" ", text(s.nameTok)});
+            list = materialItems(s);
+        }
+        for (uint32_t k = 0; s.directive != Kw::Material && k < s.count; ++k) {
             const DirectiveItem& item = ast_.items[s.first + k];
             // A vector ends at its '>', the token after its last component.
             const uint32_t last =
@@ -375,6 +378,58 @@ class Printer {
         one += " }";
         if (width(one) <= kFormatWidth) return one;
         return lines(head, items);
+    }
+
+    // A material's body: each word with the values and blocks that follow it is an item.
+    std::vector<Item> materialItems(const Stmt& s) const {
+        std::vector<Item> list;
+        for (uint32_t k = s.first; k < s.first + s.count;) {
+            const uint32_t from = k++;
+            while (k < s.first + s.count && ast_.atoms[k].kind != AtomKind::Word) ++k;
+            const Atom &a = ast_.atoms[from], &b = ast_.atoms[k - 1];
+            list.push_back({{t_[a.tok].offset, endOf(b.end)}, atoms(from, k)});
+        }
+        return list;
+    }
+
+    // Atoms [from, to) on one line; consecutive numbers keep a comma between them.
+    std::string atoms(uint32_t from, uint32_t to) const {
+        std::string s;
+        for (uint32_t k = from; k < to; ++k) {
+            if (k > from)
+                s += ast_.atoms[k].kind == AtomKind::Number &&
+                             ast_.atoms[k - 1].kind == AtomKind::Number
+                         ? ", "
+                         : " ";
+            s += atom(ast_.atoms[k]);
+        }
+        return s;
+    }
+
+    std::string atom(const Atom& a) const {
+        switch (a.kind) {
+            case AtomKind::Word:
+                return std::string(text(a.tok));
+            case AtomKind::Number:
+                return expr(a.expr);
+            case AtomKind::Vector: {
+                std::string s = "<";
+                for (uint32_t k = 0; k < a.count; ++k) {
+                    const uint32_t e = ast_.lists[a.first + k];
+                    s += cat(
+                        {k > 0 ? ", " : "", exprLevel(e) < kAdditive ? paren(expr(e)) : expr(e)});
+                }
+                return s + ">";
+            }
+            case AtomKind::Block:
+            case AtomKind::Bracket: {
+                const bool brace = a.kind == AtomKind::Block;
+                if (a.count == 0) return brace ? "{}" : "[]";
+                const std::string inner = atoms(a.first, a.first + a.count);
+                return brace ? cat({"{ ", inner, " }"}) : cat({"[", inner, "]"});
+            }
+        }
+        return {};
     }
 
     static std::string lines(const std::string& head, const std::vector<std::string>& items) {

@@ -83,8 +83,14 @@ void expectSameGraph(const Graph& a, const Graph& b) {
         const Material &m = a.materials[k], &n = b.materials[k];
         EXPECT_EQ(m.name, n.name);
         expectSameVec(m.color, n.color);
-        EXPECT_EQ(std::vector<double>({m.ambient, m.diffuse, m.phong, m.phongSize, m.reflection}),
-                  std::vector<double>({n.ambient, n.diffuse, n.phong, n.phongSize, n.reflection}));
+        EXPECT_EQ(std::vector<double>({m.ambient, m.diffuse, m.phong, m.phongSize, m.reflection,
+                                       m.brilliance, m.specular, m.roughness, m.metallic,
+                                       m.minReflection(), m.ior, m.reflectMetallic}),
+                  std::vector<double>({n.ambient, n.diffuse, n.phong, n.phongSize, n.reflection,
+                                       n.brilliance, n.specular, n.roughness, n.metallic,
+                                       n.minReflection(), n.ior, n.reflectMetallic}));
+        EXPECT_EQ(m.fresnel, n.fresnel);
+        EXPECT_EQ(m.conserveEnergy, n.conserveEnergy);
     }
     expectSameScene(a.scene, b.scene);
     EXPECT_EQ(a.timedValues.size(), b.timedValues.size());
@@ -239,6 +245,32 @@ TEST(Formatter, MessyInputBecomesCanonical) {
     ASSERT_TRUE(a->graph) << a->errors();
     ASSERT_TRUE(b->graph) << b->errors();
     expectSameGraph(*a->graph, *b->graph);
+}
+
+// A material's blocks (section 10): each item on one line when it fits, else one per line;
+// numbers in a row keep their comma, so that `{ 0.1, -0.05 }` stays two numbers.
+TEST(Formatter, MaterialBlocks) {
+    const std::string messy =
+        "material w {pigment{color rgbf<0.3,0.5,0.6,0>}\n"
+        " finish{reflection{0.1,-0.05+0.2 fresnel on}specular 0.4;metallic}interior{ior 1.33}}\n"
+        "material s { finish { phong 0.5 } }\n"
+        "paint(w) sphere ∪ paint(s) cube\n";
+    const std::string expected =
+        "material w {\n"
+        "    pigment { color rgbf <0.3, 0.5, 0.6, 0> }\n"
+        "    finish { reflection { 0.1, -0.05 + 0.2 fresnel on } specular 0.4 metallic }\n"
+        "    interior { ior 1.33 }\n"
+        "}\n"
+        "material s { finish { phong 0.5 } }\n"
+        "paint(w) sphere ∪ paint(s) cube\n";
+    EXPECT_EQ(format(messy), expected);
+    EXPECT_EQ(format(expected), expected);
+    const auto a = testing::compile(messy);
+    const auto b = testing::compile(expected);
+    ASSERT_TRUE(a->graph) << a->errors();
+    ASSERT_TRUE(b->graph) << b->errors();
+    expectSameGraph(*a->graph, *b->graph);
+    EXPECT_EQ(a->graph->materials[1].minReflection(), 0.1);
 }
 
 TEST(Formatter, LongRulesBreakAfterUnion) {

@@ -223,15 +223,31 @@ struct Light {
 };
 
 // POV-Ray 3.7's pigment colour and classic finish, with POV-Ray's defaults.
+// A material (docs/language.md sections 7 and 10): POV-Ray 3.7's texture items, with its
+// defaults. The numbered fields are those a TimedValue may set (scene_time.cpp).
 struct Material {
     std::string name;
-    Vec3 color{1, 1, 1};
-    double ambient = 0.1;
-    double diffuse = 0.6;
-    double phong = 0;
-    double phongSize = 40;
-    double reflection = 0;
+    Vec3 color{1, 1, 1};           // fields 0-2: the pigment's colour
+    double ambient = 0.1;          // 3
+    double diffuse = 0.6;          // 4
+    double phong = 0;              // 5
+    double phongSize = 40;         // 6
+    double reflection = 0;         // 7: reflection's maximum (`reflection r`: min and max)
+    double brilliance = 1;         // 8
+    double specular = 0;           // 9
+    double roughness = 0.05;       // 10: as written; POV-Ray raises to 1 / roughness
+    double metallic = 0;           // 11: highlights take the pigment's colour
+    double reflectionMin = 0;      // 12: with reflectionRange, else reflection's value
+    double ior = 1;                // 13: interior { ior }, read by fresnel reflection
+    bool reflectionRange = false;  // `reflection { min, max }`
+    bool fresnel = false;
+    double reflectMetallic = 0;  // reflection { ... metallic }
+    bool conserveEnergy = false;
+    bool interior = false;  // an interior { } was given (the exporter writes it)
+
+    double minReflection() const { return reflectionRange ? reflectionMin : reflection; }
 };
+inline constexpr uint8_t kMaterialFields = 14;
 
 struct Settings {
     uint64_t seed = 0;

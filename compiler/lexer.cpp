@@ -189,6 +189,8 @@ constexpr PunctuationTable makePunctuationTable() {
     one(')', Tok::RParen);
     one('{', Tok::LBrace);
     one('}', Tok::RBrace);
+    one('[', Tok::LBracket);
+    one(']', Tok::RBracket);
     one(',', Tok::Comma);
     one(';', Tok::Semicolon);
     one(':', Tok::Colon);
@@ -453,6 +455,7 @@ bool canEnd(const Token& t, bool directive) {
             return true;
         // A directive's '}' and a vector's '>' end an item; a C-node's '}' needs its operand.
         case Tok::RBrace:
+        case Tok::RBracket:
         case Tok::Gt:
             return directive;
         default:
@@ -509,8 +512,12 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
             case Tok::LBrace:
                 brackets.push_back('{');
                 break;
+            case Tok::LBracket:
+                brackets.push_back('[');
+                break;
             case Tok::RParen:
             case Tok::RBrace:
+            case Tok::RBracket:
                 if (!brackets.empty()) brackets.pop_back();
                 break;
             case Tok::Semicolon:

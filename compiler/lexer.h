@@ -48,6 +48,8 @@ enum class Tok : uint8_t {
     RParen,
     LBrace,
     RBrace,
+    LBracket,    // [ (colour_map entries in material blocks)
+    RBracket,    // ]
     Arrow,       // -> or →
     Union,       // | or ∪
     Intersect,   // & or ∩

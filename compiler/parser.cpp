@@ -390,8 +390,17 @@ class Parser {
                                      describe(src_, tok())));
             vector(item);
             items.push_back(item);
+        } else if (s.directive == Kw::Material) {
+            s.nameTok = name("a material");
+            if (!at(Tok::LBrace))
+                fail(p_, fmt::format("expected '{{', found {}", describe(src_, tok())));
+            const Atom body = atom();
+            s.first = body.first;
+            s.count = body.count;
+            s.last = body.end;
+            ast_.stmts.push_back(s);
+            return;
         } else {
-            if (s.directive == Kw::Material) s.nameTok = name("a material");
             block(items);
         }
         s.first = static_cast<uint32_t>(ast_.items.size());
@@ -420,6 +429,62 @@ class Parser {
             items.push_back(item);
         }
         ++p_;
+    }
+
+    // A material's body, in POV-Ray's free syntax (ast.h's Atom):
+    // atom -> WORD | sum | '<' sum { ',' sum } '>' | '{' { atom | sep } '}' | '[' { atom | sep }
+    // ']'
+    Atom atom() {
+        Atom a;
+        a.tok = a.end = pos();
+        const Token& t = tok();
+        if (at(Tok::LBrace) || at(Tok::LBracket)) {
+            const Nest nest(*this);
+            const bool brace = at(Tok::LBrace);
+            a.kind = brace ? AtomKind::Block : AtomKind::Bracket;
+            const Tok close = brace ? Tok::RBrace : Tok::RBracket;
+            ++p_;
+            std::vector<Atom> inner;
+            for (;;) {
+                while ((isSeparator(tok().kind) || at(Tok::Comma)) && !(tok().flags & kForced))
+                    ++p_;
+                if (at(close)) break;
+                if (at(Tok::End) || at(Tok::RBrace) || at(Tok::RBracket) || (tok().flags & kForced))
+                    fail(p_, fmt::format("expected {}, found {}", brace ? "'}'" : "']'",
+                                         describe(src_, tok())));
+                inner.push_back(atom());
+            }
+            a.end = pos();
+            ++p_;
+            a.first = static_cast<uint32_t>(ast_.atoms.size());
+            a.count = static_cast<uint32_t>(inner.size());
+            ast_.atoms.insert(ast_.atoms.end(), inner.begin(), inner.end());
+        } else if (at(Tok::Lt)) {
+            a.kind = AtomKind::Vector;
+            ++p_;
+            std::vector<uint32_t> parts{expr(kAdditive)};
+            while (at(Tok::Comma)) {
+                ++p_;
+                parts.push_back(expr(kAdditive));
+            }
+            if (parts.size() > 5) fail(a.tok, "a vector has at most five components");
+            expect(Tok::Gt,
+                   "'>' closing the vector (a comparison inside a vector needs parentheses)");
+            a.end = pos() - 1;
+            a.first = static_cast<uint32_t>(ast_.lists.size());
+            a.count = static_cast<uint32_t>(parts.size());
+            ast_.lists.insert(ast_.lists.end(), parts.begin(), parts.end());
+        } else if ((t.kind == Tok::Ident && tok(1).kind != Tok::LParen) ||
+                   (t.kind == Tok::Keyword && !isFunction(t.kw) && !t.isKw(Kw::Pi) &&
+                    !t.isKw(Kw::E) && !t.isKw(Kw::Clock) && !t.isKw(Kw::Frame))) {
+            a.kind = AtomKind::Word;
+            ++p_;
+        } else {
+            a.kind = AtomKind::Number;
+            a.expr = expr(kAdditive);
+            a.end = ast_.exprs[a.expr].to;
+        }
+        return a;
     }
 
     // vector -> '<' sum ',' sum ',' sum '>'     (sum: an expression without comparisons)

@@ -32,7 +32,9 @@ double* targetOf(Graph& g, const TimedValue& tv) {
             return vectorField(g.scene.background, f);
         case DirectiveTarget::Material: {
             Material& m = g.materials[tv.index];
-            double* scalars[] = {&m.ambient, &m.diffuse, &m.phong, &m.phongSize, &m.reflection};
+            double* scalars[] = {&m.ambient,    &m.diffuse,       &m.phong,    &m.phongSize,
+                                 &m.reflection, &m.brilliance,    &m.specular, &m.roughness,
+                                 &m.metallic,   &m.reflectionMin, &m.ior};
             return f < 3 ? vectorField(m.color, f) : scalars[f - 3];
         }
     }

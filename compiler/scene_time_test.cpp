@@ -65,6 +65,28 @@ TEST(SceneTime, LightsBackgroundAndMaterialsFollowTheTime) {
     EXPECT_EQ(m.diffuse, 0.6);  // untouched
 }
 
+// Values inside a material's blocks follow the time too, each into its own field.
+TEST(SceneTime, MaterialBlockValuesFollowTheTime) {
+    auto c = compile(
+        "material m { pigment { color rgb <0.2, clock, 0.4> }\n"
+        "  finish { brilliance 1 + clock specular clock / 2 roughness 0.1 * frame metallic clock\n"
+        "           reflection { clock / 4, clock } }\n"
+        "  interior { ior 1 + clock } }\n"
+        "paint(m) sphere\n");
+    ASSERT_TRUE(c->graph) << c->errors();
+    Graph& g = *c->graph;
+    setTime(g, Time{0.5, 2});
+    const Material& m = g.materials.back();
+    EXPECT_EQ(m.color, (Vec3{0.2, 0.5, 0.4}));
+    EXPECT_EQ(m.brilliance, 1.5);
+    EXPECT_EQ(m.specular, 0.25);
+    EXPECT_DOUBLE_EQ(m.roughness, 0.2);
+    EXPECT_EQ(m.metallic, 0.5);
+    EXPECT_EQ(m.minReflection(), 0.125);
+    EXPECT_EQ(m.reflection, 0.5);
+    EXPECT_EQ(m.ior, 1.5);
+}
+
 TEST(SceneTime, ParametersAndRandomnessStayForbiddenInDirectives) {
     auto c = compile("camera { location <c, -5, 2> }\n{c = 1} sphere\n");
     EXPECT_FALSE(c->graph);

@@ -218,6 +218,11 @@ class TreeSink {
         return static_cast<uint32_t>(t_.nodes.size() - 1);
     }
 
+    // The innermost paint wins: a node that has a texture keeps it.
+    void paint(uint32_t material, uint32_t& r) {
+        if (r != kNone && t_.nodes[r].texture == kNone) t_.nodes[r].texture = material;
+    }
+
   private:
     void reserveNode() {
         if (t_.nodes.size() >= maxNodes_) throw OverBudget{};
@@ -295,6 +300,8 @@ ExpandedTree expand(const Graph& g, const ExpandOptions& options) {
     Walker<TreeSink> walker(sem, sink);
     try {
         tree.root = walker.run();
+        if (tree.root != kNone && tree.nodes[tree.root].texture == kNone)
+            tree.nodes[tree.root].texture = 0;
     } catch (const OverBudget&) {
         if (count.complete)
             throw BudgetError(

@@ -24,7 +24,7 @@ namespace pcsg {
 // section 5), the accumulated object-to-world map, its material and its arguments.
 struct TreePrimitive {
     Affine toWorld;             // p_world = L p_object + t
-    uint32_t material = 0;      // index into Graph::materials (0: the default)
+    uint32_t material = 0;      // the innermost paint's, Graph::materials (0: the default)
     uint32_t firstArg = kNone;  // ExpandedTree::args: torus R r, triangle 9 coordinates
     PrimitiveKind kind = PrimitiveKind::Sphere;
 };
@@ -34,6 +34,11 @@ struct TreeNode {
     CsgOp op = CsgOp::Union;
     uint32_t first = 0;  // primitives: index into primitives; operators: into children
     uint32_t count = 0;  // operators: the number of children (at least 2)
+    // The material a paint node applied here (kNone: none), which POV-Ray gives to every
+    // primitive below that has none of its own: the exporter writes it on this node, so
+    // that `paint(m)` over a big union is one texture, not a copy on each primitive. The
+    // root has one (the default material, 0, if no paint stands there).
+    uint32_t texture = kNone;
 
     bool is(CsgOp o) const { return !primitive && op == o; }
 };

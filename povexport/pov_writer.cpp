@@ -204,6 +204,51 @@ std::string commentSafe(const std::string& s) {
     return out;
 }
 
+// Whether materials are written as POV-Ray `material { texture interior }`: when any has
+// an interior; else as textures, as before interiors existed.
+bool materialWrapped(const Graph& g) {
+    for (const Material& m : g.materials)
+        if (m.interior) return true;
+    return false;
+}
+
+// The inside of a material's texture: its pigment and finish (the items of section 10 only
+// where they differ from POV-Ray's defaults, so that a scene without them exports as before).
+void putTexture(Out& o, const Material& m) {
+    const auto item = [&](std::string_view name, double v) {
+        o.put(" {} ", name);
+        o.num(v);
+    };
+    o.put("pigment {{ color rgb ");
+    o.vec(m.color);
+    o.put(" }} finish {{ ambient ");
+    o.num(m.ambient);
+    o.put(" diffuse ");
+    o.num(m.diffuse);
+    if (m.brilliance != 1) item("brilliance", m.brilliance);
+    o.put(" phong ");
+    o.num(m.phong);
+    o.put(" phong_size ");
+    o.num(m.phongSize);
+    if (m.specular != 0) item("specular", m.specular);
+    if (m.roughness != 0.05) item("roughness", m.roughness);
+    if (m.metallic != 0) item("metallic", m.metallic);
+    if (m.reflectionRange || m.fresnel || m.reflectMetallic != 0) {
+        o.put(" reflection {{ ");
+        o.num(m.minReflection());
+        o.put(", ");
+        o.num(m.reflection);
+        if (m.fresnel) o.put(" fresnel on");
+        if (m.reflectMetallic != 0) item("metallic", m.reflectMetallic);
+        o.put(" }}");
+    } else {
+        o.put(" reflection ");
+        o.num(m.reflection);
+    }
+    if (m.conserveEnergy) o.put(" conserve_energy");
+    o.put(" }}");
+}
+
 void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& opt) {
     o.put("// POV-Ray 3.7 scene exported by pcsg export-pov{}{}\n",
           opt.title.empty() ? "" : " from ", opt.title);
@@ -226,21 +271,18 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
 
     // Materials: materials[0] is the default (white, POV-Ray's finish defaults).
     const size_t count = std::max<size_t>(g.materials.size(), 1);
+    const bool wrapped = materialWrapped(g);
     for (size_t i = 0; i < count; ++i) {
         const Material m = i < g.materials.size() ? g.materials[i] : Material{};
-        o.put("#declare M{} = texture {{ pigment {{ color rgb ", i);
-        o.vec(m.color);
-        o.put(" }} finish {{ ambient ");
-        o.num(m.ambient);
-        o.put(" diffuse ");
-        o.num(m.diffuse);
-        o.put(" phong ");
-        o.num(m.phong);
-        o.put(" phong_size ");
-        o.num(m.phongSize);
-        o.put(" reflection ");
-        o.num(m.reflection);
-        o.put(" }} }}");
+        o.put("#declare M{} = {}", i, wrapped ? "material { texture { " : "texture { ");
+        putTexture(o, m);
+        o.put(" }}");
+        if (wrapped && m.interior) {
+            o.put(" interior {{ ior ");
+            o.num(m.ior);
+            o.put(" }}");
+        }
+        if (wrapped) o.put(" }}");
         if (!m.name.empty()) o.put("  // {}", commentSafe(m.name));
         o.put("\n");
     }
@@ -278,9 +320,14 @@ Affine torusFrame() {
 }
 
 // One primitive on one line. Returns false when it was left out.
-bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p,
-                  const std::string& indent) {
-    const auto tex = [&] { o.put(" texture{{M{}}}", p.material); };
+// ` texture{M<i>}` (or ` material{M<i>}`) for a node's own texture; nothing without one.
+void putTextureRef(Out& o, uint32_t texture, bool wrapped) {
+    if (texture != kNone) o.put(" {}{{M{}}}", wrapped ? "material" : "texture", texture);
+}
+
+bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_t texture,
+                  const std::string& indent, bool wrapped) {
+    const auto tex = [&] { putTextureRef(o, texture, wrapped); };
     switch (p.kind) {
         case PrimitiveKind::Sphere:
         case PrimitiveKind::Cube:
@@ -334,19 +381,22 @@ struct Item {
     std::vector<std::pair<size_t, size_t>> slices;  // a big group's sub-groups
     bool ownsMembers = false;  // this item pushed members[lo, hi) and pops them at the end
     Box box;
+    uint32_t texture = kNone;  // a group that replaces a union: the union's own texture
 };
 
 class TreeWriter {
   public:
     static constexpr size_t kMaxNesting = 256;  // deeper unions are flattened and regrouped
 
-    TreeWriter(Out& o, const ExpandedTree& t, const PovOptions& opt, PovWriteStats& stats)
+    TreeWriter(Out& o, const ExpandedTree& t, const PovOptions& opt, PovWriteStats& stats,
+               bool wrapped)
         : o_(o),
           t_(t),
           opt_(opt),
           stats_(stats),
           boxes_(nodeBoxes(t)),
-          maxChildren_(std::max<uint32_t>(opt.maxUnionChildren, 2)) {}
+          maxChildren_(std::max<uint32_t>(opt.maxUnionChildren, 2)),
+          wrapped_(wrapped) {}
 
     void write(uint32_t root) {
         stack_.push_back(nodeItem(root));
@@ -396,6 +446,7 @@ class TreeWriter {
         const Box& b = boxes_[it.node];
         const bool bound = !node.is(CsgOp::Union) || opt_.boundUnions;
         o_.put("{}", indent());
+        putTextureRef(o_, node.texture, wrapped_);
         if (bound && boundable(b)) putBound(o_, b);
         o_.put(" }}\n");
         stack_.pop_back();
@@ -403,7 +454,7 @@ class TreeWriter {
 
     // Writes the primitive of the top item, node n, and pops it.
     void writePrimitive(uint32_t n) {
-        if (putPrimitive(o_, t_, t_.primitiveOf(n), indent()))
+        if (putPrimitive(o_, t_, t_.primitiveOf(n), t_.nodes[n].texture, indent(), wrapped_))
             ++stats_.objects;
         else
             ++stats_.skipped;
@@ -426,6 +477,7 @@ class TreeWriter {
         g.lo = lo;
         g.hi = members_.size();
         g.ownsMembers = true;
+        g.texture = t_.nodes[n].texture;
         stack_.push_back(std::move(g));
     }
 
@@ -434,7 +486,7 @@ class TreeWriter {
     void stepGroup(Item& it) {
         const size_t n = it.hi - it.lo;
         if (it.next == 0) {
-            if (n == 1) {
+            if (n == 1 && it.texture == kNone) {
                 const uint32_t only = members_[it.lo];
                 finishGroup();
                 stack_.push_back(nodeItem(only));
@@ -460,6 +512,7 @@ class TreeWriter {
             return;
         }
         o_.put("{}", indent());
+        putTextureRef(o_, it.texture, wrapped_);
         if (opt_.boundUnions && boundable(it.box)) putBound(o_, it.box);
         o_.put(" }}\n");
         finishGroup();
@@ -473,7 +526,9 @@ class TreeWriter {
             todo.pop_back();
             const uint32_t* c = t_.childrenOf(u);
             for (uint32_t i = 0; i < t_.nodes[u].count; ++i) {
-                if (t_.nodes[c[i]].is(CsgOp::Union))
+                // A union with a texture of its own stays one member: flattened, its
+                // primitives would lose the texture.
+                if (t_.nodes[c[i]].is(CsgOp::Union) && t_.nodes[c[i]].texture == kNone)
                     todo.push_back(c[i]);
                 else
                     members_.push_back(c[i]);
@@ -525,6 +580,7 @@ class TreeWriter {
     PovWriteStats& stats_;
     std::vector<Box> boxes_;
     uint32_t maxChildren_;
+    bool wrapped_;  // materials are POV-Ray `material`s (materialWrapped)
     std::vector<Item> stack_;
     std::vector<uint32_t> members_;
 };
@@ -546,7 +602,7 @@ PovWriteStats writePov(const Graph& g, const ExpandedTree& tree, std::ostream& o
     Out o(out);
     putHeader(o, g, tree, options);
     if (!tree.empty()) {
-        TreeWriter w(o, tree, options, stats);
+        TreeWriter w(o, tree, options, stats, materialWrapped(g));
         w.write(tree.root);
     } else {
         o.put("// the scene expands to nothing\n");

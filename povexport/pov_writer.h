@@ -19,8 +19,12 @@
 //                   coordinates (degenerate ones, which POV-Ray rejects, are left out)
 //      empty        nothing (the expander already folded it away)
 //  - Materials: each is declared once as `#declare M<i> = texture { pigment { color
-//    rgb <...> } finish { ambient diffuse phong phong_size reflection } }` and every
-//    primitive carries its own texture, so CSG surfaces keep their primitive's material.
+//    rgb <...> } finish { ambient diffuse phong phong_size reflection ... } }` (a POV-Ray
+//    `material` with its interior when any material has one). The texture stands where
+//    the paint node stood (ExpandedTree's TreeNode::texture): on the union or primitive
+//    the paint applies to, once, and the root carries M0. POV-Ray gives a CSG's texture to
+//    the objects below that have none, so an inner paint wins, and a CSG surface keeps its
+//    primitive's material. A union with a texture is not flattened into its parent.
 //  - ∪ ∩ \ stay nested as derived. A union with more than maxUnionChildren operands is
 //    regrouped into a balanced nest (spatially, by the operands' box centres): POV-Ray
 //    tests a union's operands one after the other (its bounding hierarchy holds only

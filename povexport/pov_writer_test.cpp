@@ -109,6 +109,72 @@ TEST(PovWriter, EachMaterialIsDeclaredOnceAsATexture) {
     EXPECT_EQ(occurrences(s, "texture{M0}"), 1u);
 }
 
+// Section 10's finish items are written where they differ from POV-Ray's defaults; a
+// material with an interior makes every material a POV-Ray `material`, so that the
+// interior travels with its texture.
+TEST(PovWriter, FinishItemsAndInteriors) {
+    Graph g;
+    defaultScene(g);
+    Material glass;
+    glass.name = "glass";
+    glass.brilliance = 2;
+    glass.specular = 0.5;
+    glass.roughness = 0.01;
+    glass.metallic = 0.25;
+    glass.reflectionRange = true;
+    glass.reflectionMin = 0.05;
+    glass.reflection = 0.9;
+    glass.fresnel = true;
+    glass.reflectMetallic = 1;
+    glass.conserveEnergy = true;
+    glass.interior = true;
+    glass.ior = 1.5;
+    g.materials.push_back(glass);
+    g.axiom =
+        g.addOperator(CsgOp::Union, {paint(g, 1, primitive(g, P::Sphere)), primitive(g, P::Cube)});
+    const std::string s = exportText(g);
+    EXPECT_NE(s.find("#declare M0 = material { texture { pigment { color rgb <1,1,1> } finish { "
+                     "ambient 0.1 diffuse 0.6 phong 0 phong_size 40 reflection 0 } } }"),
+              std::string::npos)
+        << s;
+    EXPECT_NE(s.find("#declare M1 = material { texture { pigment { color rgb <1,1,1> } finish { "
+                     "ambient 0.1 diffuse 0.6 brilliance 2 phong 0 phong_size 40 specular 0.5 "
+                     "roughness 0.01 metallic 0.25 reflection { 0.05, 0.9 fresnel on metallic 1 } "
+                     "conserve_energy } } interior { ior 1.5 } }  // glass"),
+              std::string::npos)
+        << s;
+    EXPECT_EQ(occurrences(s, "material{M1}"), 1u);
+    EXPECT_EQ(occurrences(s, "material{M0}"), 1u);
+    EXPECT_EQ(occurrences(s, "texture{M"), 0u);
+}
+
+// A paint node's material is one texture where the paint stands (docs/language.md
+// section 10): on the union it paints, not copied onto each primitive. An inner paint is
+// a texture of its own, which POV-Ray keeps (inner textures override outer), and the root
+// carries the default material for what no paint reaches.
+TEST(PovWriter, APaintIsOneTextureWhereThePaintStands) {
+    Graph g;
+    defaultScene(g);
+    g.materials.push_back(Material{"a"});
+    g.materials.push_back(Material{"b"});
+    std::vector<NodeId> inner;
+    for (int i = 0; i < 40; ++i)  // more than maxUnionChildren: the union is regrouped
+        inner.push_back(
+            transform(g, TransformOp::Move, {double(i), 0, 0}, primitive(g, P::Sphere)));
+    inner.push_back(paint(g, 2, primitive(g, P::Cone)));
+    const NodeId painted = paint(g, 1, g.addOperator(CsgOp::Union, inner));
+    g.axiom = g.addOperator(CsgOp::Union, {painted, primitive(g, P::Cylinder)});
+    const std::string s = exportText(g);
+    EXPECT_EQ(occurrences(s, "texture{M1}"), 1u) << s;
+    EXPECT_EQ(occurrences(s, "texture{M2}"), 1u) << s;
+    EXPECT_EQ(occurrences(s, "texture{M0}"), 1u) << s;
+    EXPECT_NE(s.find("cone{<0,0,0>,1,<0,0,1>,0 texture{M2}"), std::string::npos) << s;
+    EXPECT_EQ(occurrences(s, "sphere{<0,0,0>,1 matrix"), 40u) << s;
+    // The root union closes with the default texture, after every primitive.
+    EXPECT_GT(s.rfind(" texture{M0}"), s.rfind("cylinder{")) << s;
+    EXPECT_GT(s.rfind(" texture{M1}"), s.rfind("sphere{")) << s;
+}
+
 TEST(PovWriter, PrimitivesInPovRaysOwnFormWithTheTransposedMatrix) {
     // move(1,2,3) uscale(2): L = 2I, t = (1,2,3).
     const std::string m = " matrix<2,0,0,0,2,0,0,0,2,1,2,3>}";

@@ -15,23 +15,39 @@
 //    "if the surface normal points away, flip its direction"). CSG surfaces and triangles
 //    are therefore lit from whichever side is seen.
 //  - Ambient: pigment * ambient * ambient_light, ambient_light = 1 (POV-Ray's default).
-//  - For each point light at position Lp with colour Lc, L = normalize(Lp - P):
+//  - For each point light at position Lp with colour Lc, L = normalize(Lp - P) (no light
+//    is looked at when diffuse, phong and specular are all 0):
 //      * skipped if N . L < EPSILON (1e-10): the light is behind the surface;
 //      * hard shadow: a shadow ray from P toward the light; blocked by any surface with
 //        SHADOW_TOLERANCE (1e-3) < t < |Lp - P| - SHADOW_TOLERANCE;
-//      * diffuse: Lc * pigment * diffuse * |N . L| (brilliance 1);
-//      * phong: with R = D - 2 (D . N) N the mirrored view direction, if R . L > 0:
-//        Lc * phong * (R . L)^phong_size (highlight in the light's colour, not metallic).
+//      * diffuse (ComputeDiffuseColour): Lc * pigment * diffuse * |N . L|^brilliance;
+//      * phong (ComputePhongColour): with R = D - 2 (D . N) N the mirrored view direction,
+//        if R . L > 0: phong * (R . L)^phong_size, 0 when phong_size >= 60 and R . L <=
+//        0.0008 (POV-Ray's cut-off);
+//      * specular (ComputeSpecularColour): with H = (L - D) / 2, if c = H . N / |H| > 0:
+//        specular * c^(1 / roughness);
+//      * a highlight is in the light's colour; with finish `metallic k` it is Lc * (1 + k
+//        (1 - F) (pigment - 1)), F POV-Ray's empirical Fresnel term of acos(N . L):
+//        x = acos / (pi/2), F = clamp(0.014567225 / (x - 1.12)^2 - 0.011612903, 0, 1).
 //    No light attenuation with distance (POV-Ray's default fade_power 0).
-//  - Reflection `reflection r` (POV-Ray's `reflection r` sets min = max = r, falloff 1, no
-//    fresnel): the colour gets + r * colour(reflected ray), the reflected ray starting at
-//    P in direction D - 2 (D . N) N. The ray's weight (1 for camera rays) is multiplied by
-//    r; a ray whose weight drops below adc_bailout (1/255) is not traced, and neither is
-//    a ray beyond max_trace_level (5: the camera ray and at most four reflections).
-//    Since reflection is linear, the tracer follows the chain of reflections in a loop.
-//  - Materials: POV-Ray's defaults for items left out (ambient 0.1, diffuse 0.6, phong 0,
-//    phong_size 40, reflection 0; graph.h's Material), colour <1,1,1> for the default
-//    material.
+//  - Reflection (ComputeReflectivity, reflection_type 0 or 1, falloff 1), with cos = -D . N:
+//      * without fresnel, amount = min when 1 - cos is 0, max when it is 1, else (1 - cos)
+//        max + cos min; the ray's weight is multiplied by max(min, max);
+//      * with fresnel, f = POV-Ray's Fresnel formula for unpolarised light at the relative
+//        ior (the interior's: the ray comes from the atmosphere), amount = f max + (1 - f)
+//        min (max when the square root's argument is not positive); the weight is
+//        multiplied by the amount;
+//      * `reflection { ... metallic k }` tints the amount by 1 + k (1 - F) (pigment - 1),
+//        F as above of acos(cos);
+//      * the colour gets + amount * colour(reflected ray), the reflected ray starting at P
+//        in direction D - 2 (D . N) N. A ray whose weight drops below adc_bailout (1/255) is
+//        not traced, and neither is a ray beyond max_trace_level (5: the camera ray and at
+//        most four reflections). Since reflection is linear, the tracer follows the chain of
+//        reflections in a loop.
+//  - conserve_energy changes only the light an object transmits, so nothing while there is
+//    no transparency.
+//  - Materials: POV-Ray's defaults for items left out (graph.h's Material), colour <1,1,1>
+//    for the default material.
 //  - Output: linear colours; images are encoded as sRGB (render.h) as POV-Ray 3.7 does with
 //    assumed_gamma 1.0.
 #pragma once
@@ -54,6 +70,14 @@ struct ShadingConstants {
     static constexpr double kAmbientLight = 1.0;
 };
 
+// How much a surface reflects at an angle of incidence with cosine `cosIncidence`: the
+// colour that multiplies the reflected ray's, and the factor of the ray's weight.
+struct Reflectivity {
+    Vec3 colour{0, 0, 0};
+    double weight = 0;
+};
+Reflectivity reflectivity(const Material& m, double cosIncidence);
+
 // The colour seen along one ray, per thread (it owns a Tracer).
 class Shader {
   public:
@@ -70,6 +94,9 @@ class Shader {
   private:
     // The local colour of a surface point (ambient, diffuse, phong; no reflection).
     Vec3 local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m);
+    // Diffuse, phong and specular of one unshadowed light in direction l.
+    Vec3 lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
+             const Material& m) const;
 
     const Graph& g_;
     Tracer tracer_;

@@ -6,8 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
+#include <string>
 
 #include "bounds.h"
 #include "test_support.h"
@@ -192,6 +195,90 @@ TEST(Shading, ReflectionStopsAfterMaxTraceLevelFive) {
 TEST(Shading, ReflectionStopsBelowAdcBailout) {
     // r = 0.1: the third reflection would have weight 0.001 < 1/255: three rays only.
     EXPECT_NEAR(betweenMirrors(0.1), 0.2 * (1 + 0.1 + 0.01), 1e-12);
+}
+
+// POV-Ray's empirical Fresnel term of metallic highlights, at the angle of cosine c.
+double metallicF(double c) {
+    const double x = std::acos(c) / (std::numbers::pi / 2);
+    return std::clamp(0.014567225 / ((x - 1.12) * (x - 1.12)) - 0.011612903, 0.0, 1.0);
+}
+
+// Section 10's finish on a sphere: brilliance, specular with roughness, and metallic phong
+// and specular highlights tinted by the pigment, each computed here from its definition.
+TEST(Shading, BrillianceSpecularAndMetallicHighlights) {
+    Lit l = make(R"(
+light      { position <4, -6, 5>  color <0.9, 0.8, 0.7> }
+material m { pigment { color rgb <0.8, 0.5, 0.3> }
+             finish { ambient 0.15 diffuse 0.65 brilliance 2.5 phong 0.4 phong_size 25
+                      specular 0.6 roughness 0.04 metallic 0.7 } }
+paint(m) sphere
+)");
+    ASSERT_TRUE(l.shader);
+    const Vec3 light{4, -6, 5}, lc{0.9, 0.8, 0.7}, colour{0.8, 0.5, 0.3};
+    std::mt19937_64 rng(12);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int specular = 0;
+    for (int i = 0; i < 400; ++i) {
+        Vec3 eye = normalize(Vec3{u(rng), u(rng), u(rng)}) * (3 + 2 * std::fabs(u(rng)));
+        const Vec3 onSphere = normalize(Vec3{u(rng), u(rng), u(rng)});
+        if (dot(onSphere, eye - onSphere) <= 0.05) continue;
+        const Vec3 d = normalize(onSphere - eye);
+        const double b = dot(eye, d), cc = dot(eye, eye) - 1;
+        const Vec3 p = eye + d * (-b - std::sqrt(b * b - cc));
+        const Vec3 n = normalize(p), L = normalize(light - p);
+        Vec3 want = colour * 0.15;
+        const double nl = dot(n, L);
+        if (nl > 0) {
+            want += mul(lc, colour) * (0.65 * std::pow(nl, 2.5));
+            const double k = 0.7 * (1 - metallicF(nl));
+            const Vec3 tinted = mul(
+                lc, Vec3{1 + k * (colour.x - 1), 1 + k * (colour.y - 1), 1 + k * (colour.z - 1)});
+            const double rl = dot(d - n * (2 * dot(d, n)), L);
+            if (rl > 0) want += tinted * (0.4 * std::pow(rl, 25));
+            const Vec3 h = normalize(L - d);  // halfway between light and viewer
+            const double nh = dot(n, h);
+            if (nh > 0) want += tinted * (0.6 * std::pow(nh, 1 / 0.04));
+            if (nh > 0 && std::pow(nh, 25) > 0.1) ++specular;
+        }
+        expectColour(l.shader->shade(Ray{eye, d}), want, "sphere", 1e-9);
+    }
+    EXPECT_GT(specular, 0);
+}
+
+// reflection { min, max }: min looking straight down, max at grazing angles, (1 - cos)
+// between; with fresnel, the Fresnel reflectance of a dielectric of the interior's ior
+// (computed here from the s and p polarisations); metallic tints it by the pigment.
+TEST(Shading, ReflectionRangeFresnelAndMetallic) {
+    const auto floorColour = [](const char* finish, double cosI) {
+        const std::string text = std::string("background <0.2, 0.4, 0.8>\n") +
+                                 "material f { pigment { color rgb <1, 0.5, 0.25> } finish { "
+                                 "ambient 0 diffuse 0 " +
+                                 finish + " } interior { ior 1.5 } }\npaint(f) plane\n";
+        auto c = compile(text);
+        EXPECT_TRUE(c->graph) << c->diags.format();
+        if (!c->graph) return Vec3{};
+        TraceScene scene(*c->graph, computeBounds(*c->graph));
+        Shader shader(scene);
+        const double sinI = std::sqrt(1 - cosI * cosI);
+        return shader.shade(Ray{{0, 0, 1}, Vec3{sinI, 0, -cosI}});
+    };
+    const Vec3 sky{0.2, 0.4, 0.8};
+    for (double cosI : {1.0, 0.8, 0.5, 0.2, 0.05}) {
+        const double frac = 1 - cosI;
+        const double plain = cosI == 1.0 ? 0.1 : frac * 0.7 + (1 - frac) * 0.1;
+        expectColour(floorColour("reflection { 0.1, 0.7 }", cosI), sky * plain, "range");
+        const double n = 1.5, sinT = std::sqrt(1 - cosI * cosI) / n;
+        const double cosT = std::sqrt(1 - sinT * sinT);
+        const double rs = std::pow((cosI - n * cosT) / (cosI + n * cosT), 2);
+        const double rp = std::pow((n * cosI - cosT) / (n * cosI + cosT), 2);
+        const double f = (rs + rp) / 2;
+        expectColour(floorColour("reflection { 0.1, 0.7 fresnel on }", cosI),
+                     sky * (f * 0.7 + (1 - f) * 0.1), "fresnel");
+        const double k = 1 - metallicF(cosI);
+        const Vec3 tint{1, 1 + k * (0.5 - 1), 1 + k * (0.25 - 1)};
+        expectColour(floorColour("reflection { 0.1, 0.7 metallic }", cosI), mul(sky, tint) * plain,
+                     "metallic");
+    }
 }
 
 }  // namespace

@@ -1,0 +1,447 @@
+// Reading a material's body: see build_material.h.
+#include "build_material.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <optional>
+#include <string_view>
+
+namespace pcsg {
+
+namespace {
+
+constexpr uint8_t kConstant = 255;  // the field of a value that may not read the time
+
+constexpr std::string_view kMaterialTakes =
+    "color, ambient, diffuse, phong, phong_size, reflection and the blocks pigment, normal, "
+    "finish, interior";
+constexpr std::string_view kPigmentTakes = "color (rgb, rgbf, rgbt, rgbft)";
+constexpr std::string_view kFinishTakes =
+    "ambient, diffuse, brilliance, phong, phong_size, specular, roughness, metallic, reflection, "
+    "conserve_energy";
+constexpr std::string_view kInteriorTakes = "ior";
+
+// Items of section 10 that the language defines and the renderers do not have yet.
+constexpr std::array<std::string_view, 26> kPigmentLater = {
+    "checker", "gradient",  "onion",      "leopard",   "radial",   "brick",      "hexagon",
+    "bozo",    "spotted",   "granite",    "wood",      "marble",   "agate",      "wrinkles",
+    "dents",   "color_map", "colour_map", "frequency", "phase",    "turbulence", "octaves",
+    "omega",   "lambda",    "scale",      "rotate",    "translate"};
+constexpr std::array<std::string_view, 5> kNormalLater = {"bumps", "dents", "wrinkles", "ripples",
+                                                          "waves"};
+constexpr std::array<std::string_view, 2> kInteriorLater = {"fade_distance", "fade_power"};
+
+template <size_t N>
+bool among(const std::array<std::string_view, N>& names, std::string_view n) {
+    for (std::string_view s : names)
+        if (s == n) return true;
+    return false;
+}
+
+bool isColourWord(std::string_view w) {
+    return w == "color" || w == "colour" || w == "rgb" || w == "rgbf" || w == "rgbt" ||
+           w == "rgbft";
+}
+
+class MaterialReader {
+  public:
+    MaterialReader(BuildContext& ctx, ExprCompiler& exprs, uint32_t index)
+        : ctx_(ctx), ast_(ctx.ast), exprs_(exprs), m_(ctx.g.materials[index]), index_(index) {}
+
+    void body(const Stmt& s);
+
+  private:
+    struct Range {
+        uint32_t i, end;
+        bool done() const { return i >= end; }
+    };
+    const Atom& peek(const Range& r) const { return ast_.atoms[r.i]; }
+    bool nextIs(const Range& r, AtomKind k) const { return !r.done() && peek(r).kind == k; }
+    std::string_view word(const Atom& a) const { return ctx_.text(a.tok); }
+    static Range inside(const Atom& a) { return {a.first, a.first + a.count}; }
+    std::string describeAtom(const Atom& a) const;
+
+    std::optional<double> value(uint32_t expr, uint8_t field);
+    std::optional<double> number(Range& r, const Atom& item, uint8_t field);
+    std::optional<Vec3> colour(Range& r, const Atom& item, uint8_t field);
+    std::optional<Vec3> colourComponents(const Atom& model, const Atom& v, uint8_t field);
+    const Atom* block(Range& r, const Atom& item);
+    bool flag(Range& r);
+    void skipValues(Range& r);
+    void reject(Range& r, const Atom& item, std::string_view block, std::string_view takes);
+
+    bool flatItem(Range& r, const Atom& item, std::string_view n);
+    void pigment(Range r);
+    void finish(Range r);
+    bool finishItem(Range& r, const Atom& item, std::string_view n);
+    void reflection(Range& r, const Atom& item);
+    void reflectionBlock(Range r, const Atom& item);
+    void normal(Range r);
+    void interior(Range r);
+    void checkPositive(const Atom& item, double v);
+
+    BuildContext& ctx_;
+    const Ast& ast_;
+    ExprCompiler& exprs_;
+    Material& m_;
+    uint32_t index_;
+    bool timed_ = false;  // the last value read reads the time
+};
+
+std::string MaterialReader::describeAtom(const Atom& a) const {
+    return describe(ctx_.src, ctx_.tokens[a.tok]);
+}
+
+// A value: a constant, or one that reads the time, kept as a TimedValue of this material.
+std::optional<double> MaterialReader::value(uint32_t expr, uint8_t field) {
+    timed_ = false;
+    if (field == kConstant) return exprs_.constant(expr);
+    const auto v = exprs_.directiveValue(expr);
+    if (!v) return std::nullopt;
+    if (v->timed != kNone) {
+        ctx_.g.timedValues.push_back(
+            TimedValue{DirectiveTarget::Material, index_, field, v->timed});
+        timed_ = true;
+    }
+    return v->value;
+}
+
+// The number that follows `item`.
+std::optional<double> MaterialReader::number(Range& r, const Atom& item, uint8_t field) {
+    if (nextIs(r, AtomKind::Number)) return value(ast_.atoms[r.i++].expr, field);
+    if (nextIs(r, AtomKind::Vector)) {
+        ctx_.error(item.tok, fmt::format("'{}' takes a number, not a vector", clip(word(item))));
+        ++r.i;
+    } else if (nextIs(r, AtomKind::Word) && isColourWord(word(peek(r)))) {
+        ctx_.error(item.tok,
+                   fmt::format("'{}' takes a number here, not a colour", clip(word(item))));
+        ++r.i;
+        skipValues(r);
+    } else {
+        ctx_.error(item.tok, fmt::format("'{}' takes a number", clip(word(item))));
+    }
+    return std::nullopt;
+}
+
+// A colour after `item` (`color` or a model word itself): `<r, g, b>` or POV-Ray's `rgb
+// <r, g, b>`, `rgbf <r, g, b, f>`, `rgbt <r, g, b, t>`, `rgbft <r, g, b, f, t>`, `rgb x`.
+// Its red, green and blue go to fields `field` to `field + 2`.
+std::optional<Vec3> MaterialReader::colour(Range& r, const Atom& item, uint8_t field) {
+    const Atom* model = &item;
+    if (word(item) == "color" || word(item) == "colour") {
+        if (nextIs(r, AtomKind::Vector)) return colourComponents(item, ast_.atoms[r.i++], field);
+        if (!nextIs(r, AtomKind::Word)) {
+            ctx_.error(item.tok, fmt::format("'{}' takes a vector '<x, y, z>' or rgb, rgbf, "
+                                             "rgbt, rgbft and a vector",
+                                             clip(word(item))));
+            skipValues(r);
+            return std::nullopt;
+        }
+        model = &ast_.atoms[r.i++];
+    }
+    const std::string_view m = word(*model);
+    if (m != "rgb" && m != "rgbf" && m != "rgbt" && m != "rgbft") {
+        ctx_.error(model->tok, fmt::format("expected rgb, rgbf, rgbt, rgbft or a vector '<r, g, "
+                                           "b>' in a colour, found '{}'",
+                                           clip(m)));
+        skipValues(r);
+        return std::nullopt;
+    }
+    if (m == "rgb" && nextIs(r, AtomKind::Number)) {
+        const auto g = value(ast_.atoms[r.i++].expr, kConstant);
+        if (!g) return std::nullopt;
+        return Vec3{*g, *g, *g};
+    }
+    if (!nextIs(r, AtomKind::Vector)) {
+        ctx_.error(model->tok, fmt::format("'{}' takes a vector", clip(m)));
+        skipValues(r);
+        return std::nullopt;
+    }
+    return colourComponents(*model, ast_.atoms[r.i++], field);
+}
+
+// The components of a colour vector `v` after the model word (or `color`).
+std::optional<Vec3> MaterialReader::colourComponents(const Atom& model, const Atom& v,
+                                                     uint8_t field) {
+    const std::string_view m = word(model);
+    const uint32_t want = m == "rgbft" ? 5 : (m == "rgbf" || m == "rgbt") ? 4 : 3;
+    if (v.count != want) {
+        ctx_.error(v.tok, fmt::format("'{}' takes a vector of {} components, found {}", clip(m),
+                                      want, v.count));
+        return std::nullopt;
+    }
+    Vec3 c;
+    bool ok = true;
+    for (uint32_t k = 0; k < v.count; ++k) {
+        const uint8_t f =
+            (k < 3 && field != kConstant) ? static_cast<uint8_t>(field + k) : kConstant;
+        const auto x = value(ast_.lists[v.first + k], f);
+        if (!x) {
+            ok = false;
+        } else if (k < 3) {
+            c[static_cast<int>(k)] = *x;
+        } else if (*x != 0) {
+            ctx_.error(v.tok,
+                       "filter and transmit (transparency) are not implemented yet: "
+                       "they must be 0");
+            ok = false;
+        }
+    }
+    if (!ok) return std::nullopt;
+    return c;
+}
+
+// The block `{ ... }` that follows `item`, or null (reported).
+const Atom* MaterialReader::block(Range& r, const Atom& item) {
+    if (nextIs(r, AtomKind::Block)) return &ast_.atoms[r.i++];
+    ctx_.error(item.tok, fmt::format("'{}' takes a block '{{ ... }}'", clip(word(item))));
+    skipValues(r);
+    return nullptr;
+}
+
+// An optional boolean after a flag word (`fresnel`, `conserve_energy`): on, off, true,
+// false, yes, no or a number; the flag alone is on.
+bool MaterialReader::flag(Range& r) {
+    if (nextIs(r, AtomKind::Number)) {
+        const auto v = value(ast_.atoms[r.i++].expr, kConstant);
+        return v && *v != 0;
+    }
+    if (nextIs(r, AtomKind::Word)) {
+        const std::string_view w = word(peek(r));
+        const bool on = w == "on" || w == "true" || w == "yes";
+        if (on || w == "off" || w == "false" || w == "no") {
+            ++r.i;
+            return on;
+        }
+    }
+    return true;
+}
+
+// After an error: the values up to the next word, so that one mistake is one error.
+void MaterialReader::skipValues(Range& r) {
+    while (!r.done() && peek(r).kind != AtomKind::Word) ++r.i;
+}
+
+// An item the block does not take: not implemented yet (section 10), or unknown.
+void MaterialReader::reject(Range& r, const Atom& item, std::string_view block,
+                            std::string_view takes) {
+    const std::string_view n = word(item);
+    const bool later = (block == "pigment" && among(kPigmentLater, n)) ||
+                       (block == "normal" && among(kNormalLater, n)) ||
+                       (block == "interior" && among(kInteriorLater, n));
+    if (later)
+        ctx_.error(item.tok, fmt::format("'{}' in {} is not implemented yet ({} takes {})", clip(n),
+                                         block, block, takes));
+    else
+        ctx_.error(item.tok, fmt::format("unknown {} setting '{}' ({} takes {})", block, clip(n),
+                                         block, takes));
+    skipValues(r);
+    while (nextIs(r, AtomKind::Block) || nextIs(r, AtomKind::Bracket)) ++r.i;
+}
+
+void MaterialReader::checkPositive(const Atom& item, double v) {
+    if (!timed_ && !(v > 0))
+        ctx_.error(item.tok,
+                   fmt::format("{} must be greater than 0, found {}", clip(word(item)), v));
+}
+
+void MaterialReader::body(const Stmt& s) {
+    Range r{s.first, s.first + s.count};
+    while (!r.done()) {
+        const Atom& item = ast_.atoms[r.i++];
+        if (item.kind != AtomKind::Word) {
+            ctx_.error(item.tok,
+                       fmt::format("expected a material setting, found {}", describeAtom(item)));
+            continue;
+        }
+        const std::string_view n = word(item);
+        if (flatItem(r, item, n)) continue;
+        const bool isBlock = n == "pigment" || n == "finish" || n == "normal" || n == "interior";
+        if (!isBlock) {
+            reject(r, item, "material", kMaterialTakes);
+            continue;
+        }
+        const Atom* b = block(r, item);
+        if (!b) continue;
+        if (n == "pigment") pigment(inside(*b));
+        if (n == "finish") finish(inside(*b));
+        if (n == "normal") normal(inside(*b));
+        if (n == "interior") interior(inside(*b));
+    }
+}
+
+// The shorthand of section 7: color, ambient, diffuse, phong, phong_size, reflection.
+bool MaterialReader::flatItem(Range& r, const Atom& item, std::string_view n) {
+    if (n == "color" || n == "colour") {
+        if (nextIs(r, AtomKind::Number)) {
+            ctx_.error(item.tok, fmt::format("'{}' takes a vector '<x, y, z>'", clip(n)));
+            ++r.i;
+        } else if (auto c = colour(r, item, 0)) {
+            m_.color = *c;
+        }
+        return true;
+    }
+    if (n == "reflection") {
+        if (auto v = number(r, item, 7)) {
+            m_.reflection = *v;
+            m_.reflectionRange = false;
+        }
+        return true;
+    }
+    if (n == "ambient" || n == "diffuse" || n == "phong" || n == "phong_size")
+        return finishItem(r, item, n);
+    return false;
+}
+
+void MaterialReader::pigment(Range r) {
+    while (!r.done()) {
+        const Atom& item = ast_.atoms[r.i++];
+        if (item.kind != AtomKind::Word) {
+            ctx_.error(item.tok,
+                       fmt::format("expected a pigment item, found {}", describeAtom(item)));
+            continue;
+        }
+        const std::string_view n = word(item);
+        if (isColourWord(n)) {
+            if (auto c = colour(r, item, 0)) m_.color = *c;
+            continue;
+        }
+        reject(r, item, "pigment", kPigmentTakes);
+    }
+}
+
+void MaterialReader::finish(Range r) {
+    while (!r.done()) {
+        const Atom& item = ast_.atoms[r.i++];
+        if (item.kind != AtomKind::Word) {
+            ctx_.error(item.tok,
+                       fmt::format("expected a finish item, found {}", describeAtom(item)));
+            continue;
+        }
+        const std::string_view n = word(item);
+        if (n == "reflection") {
+            reflection(r, item);
+        } else if (n == "conserve_energy") {
+            m_.conserveEnergy = flag(r);
+        } else if (n == "metallic") {
+            m_.metallic = 1;
+            if (nextIs(r, AtomKind::Number))
+                if (auto v = number(r, item, 11)) m_.metallic = *v;
+        } else if (!finishItem(r, item, n)) {
+            reject(r, item, "finish", kFinishTakes);
+        }
+    }
+}
+
+// The finish items that are one number.
+bool MaterialReader::finishItem(Range& r, const Atom& item, std::string_view n) {
+    struct Field {
+        std::string_view name;
+        uint8_t field;
+        double Material::*member;
+    };
+    static constexpr Field kFields[] = {
+        {"ambient", 3, &Material::ambient},       {"diffuse", 4, &Material::diffuse},
+        {"phong", 5, &Material::phong},           {"phong_size", 6, &Material::phongSize},
+        {"brilliance", 8, &Material::brilliance}, {"specular", 9, &Material::specular},
+        {"roughness", 10, &Material::roughness}};
+    for (const Field& f : kFields) {
+        if (n != f.name) continue;
+        if (auto v = number(r, item, f.field)) {
+            if (n == "roughness") checkPositive(item, *v);
+            m_.*f.member = *v;
+        }
+        return true;
+    }
+    return false;
+}
+
+// `reflection r` or `reflection { [min,] max [fresnel on] [metallic [m]] }`.
+void MaterialReader::reflection(Range& r, const Atom& item) {
+    if (nextIs(r, AtomKind::Block)) {
+        reflectionBlock(inside(ast_.atoms[r.i++]), item);
+        return;
+    }
+    if (auto v = number(r, item, 7)) {
+        m_.reflection = *v;
+        m_.reflectionRange = false;
+    }
+}
+
+void MaterialReader::reflectionBlock(Range r, const Atom& at) {
+    uint32_t count = 0;
+    while (count < 2 && r.i + count < r.end && ast_.atoms[r.i + count].kind == AtomKind::Number)
+        ++count;
+    if (count == 1) {  // one value is both the minimum and the maximum
+        if (auto v = value(ast_.atoms[r.i].expr, 7)) m_.reflection = *v;
+        m_.reflectionRange = false;
+    } else if (count == 2) {
+        if (auto v = value(ast_.atoms[r.i].expr, 12)) m_.reflectionMin = *v;
+        if (auto v = value(ast_.atoms[r.i + 1].expr, 7)) m_.reflection = *v;
+        m_.reflectionRange = true;
+    }
+    r.i += count;
+    while (!r.done()) {
+        const Atom& item = ast_.atoms[r.i++];
+        const std::string_view n = item.kind == AtomKind::Word ? word(item) : "";
+        if (n == "fresnel") {
+            m_.fresnel = flag(r);
+        } else if (n == "metallic") {
+            m_.reflectMetallic = 1;
+            if (nextIs(r, AtomKind::Number))
+                if (auto v = value(ast_.atoms[r.i++].expr, kConstant)) m_.reflectMetallic = *v;
+        } else if (item.kind != AtomKind::Word) {
+            ctx_.error(item.tok, fmt::format("reflection {{ }} takes one or two numbers first "
+                                             "(min, max), found {}",
+                                             describeAtom(item)));
+        } else {
+            ctx_.error(item.tok,
+                       fmt::format("unknown reflection setting '{}' (reflection {{ }} takes a "
+                                   "minimum and maximum, fresnel, metallic)",
+                                   clip(n)));
+            skipValues(r);
+        }
+    }
+    if (count == 0) ctx_.error(at.tok, "reflection { } needs its amount: { max } or { min, max }");
+}
+
+void MaterialReader::normal(Range r) {
+    while (!r.done()) {
+        const Atom& item = ast_.atoms[r.i++];
+        if (item.kind != AtomKind::Word) {
+            ctx_.error(item.tok,
+                       fmt::format("expected a normal item, found {}", describeAtom(item)));
+            continue;
+        }
+        reject(r, item, "normal", "no item yet");
+    }
+}
+
+void MaterialReader::interior(Range r) {
+    while (!r.done()) {
+        const Atom& item = ast_.atoms[r.i++];
+        if (item.kind == AtomKind::Word && word(item) == "ior") {
+            if (auto v = number(r, item, 13)) {
+                checkPositive(item, *v);
+                m_.ior = *v;
+                m_.interior = true;
+            }
+            continue;
+        }
+        if (item.kind != AtomKind::Word) {
+            ctx_.error(item.tok,
+                       fmt::format("expected an interior item, found {}", describeAtom(item)));
+            continue;
+        }
+        reject(r, item, "interior", kInteriorTakes);
+    }
+}
+
+}  // namespace
+
+void readMaterial(BuildContext& ctx, ExprCompiler& exprs, const Stmt& s, uint32_t index) {
+    MaterialReader(ctx, exprs, index).body(s);
+}
+
+}  // namespace pcsg
