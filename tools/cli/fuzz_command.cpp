@@ -246,6 +246,19 @@ int runFuzz(FuzzOptions o) {
     return c.disagree.empty() ? 0 : 1;
 }
 
+// verify's thresholds, which are fuzz's defaults too.
+void addThresholdOptions(CLI::App* cmd, FuzzOptions& o) {
+    cmd->add_option("--pixel-threshold", o.thresholds.pixelOff,
+                    "As verify's: a pixel is off when a channel differs by more than this")
+        ->capture_default_str();
+    cmd->add_option("--max-off", o.thresholds.maxShareOff,
+                    "As verify's: agree only if at most this share of pixels is off")
+        ->capture_default_str();
+    cmd->add_option("--max-mean-error", o.thresholds.maxMeanError,
+                    "As verify's: agree only if the mean absolute error is at most this")
+        ->capture_default_str();
+}
+
 }  // namespace
 
 void addFuzzCommand(CLI::App& app, int& status) {
@@ -281,6 +294,7 @@ void addFuzzCommand(CLI::App& app, int& status) {
         ->check(CLI::PositiveNumber);
     cmd->add_option("--threads", o->threads, "Threads for both renderers (default: all cores)")
         ->check(CLI::NonNegativeNumber);
+    addThresholdOptions(cmd, *o);
     cmd->add_option("--out", o->outDir,
                     "Write the cases here (default: a temporary directory, kept only when there "
                     "are cases)");

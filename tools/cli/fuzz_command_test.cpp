@@ -51,6 +51,34 @@ TEST(FuzzCommand, JsonOfAShortCampaign) {
     EXPECT_NE(r.err.find("system 1 (seed"), std::string::npos) << r.err;
 }
 
+// Thresholds that no pair of images can meet (a negative mean error) make every system
+// differ: exit status 1, and a shrunk case with everything in it.
+TEST(FuzzCommand, ADisagreementLeavesAShrunkCase) {
+    if (!inPath("povray")) GTEST_SKIP() << "POV-Ray is not installed";
+    TempDir dir;
+    const ChildResult r =
+        pcsg({"fuzz", "--count", "1", "--seed", "7", "--width", "32", "--height", "24", "--threads",
+              "1", "--max-mean-error", "-1", "--json", "--out", dir.path(), "--shrink-tries", "4"});
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["agree"].get<int>(), 0);
+    ASSERT_EQ(j["disagree"].size(), 1u);
+    const std::string c = j["disagree"][0].get<std::string>();
+    EXPECT_EQ(c, dir.path() + "/case-1");
+    for (const char* f :
+         {"shrunk.pcsg", "original.pcsg", "native.png", "povray.png", "diff.png", "what.txt"})
+        EXPECT_TRUE(std::filesystem::exists(c + "/" + f)) << f;
+    const std::string shrunk = testing::readFile(c + "/shrunk.pcsg");
+    EXPECT_LT(shrunk.size(), testing::readFile(c + "/original.pcsg").size());
+    EXPECT_NE(testing::readFile(c + "/what.txt").find("the images differ"), std::string::npos);
+    // The generated system is the one --generate-only writes for the same seed.
+    const ChildResult g = pcsg(
+        {"fuzz", "--generate-only", "--count", "1", "--seed", "7", "--out", dir.path() + "/gen"});
+    ASSERT_EQ(g.exitCode, 0) << g.err;
+    EXPECT_EQ(testing::readFile(dir.path() + "/gen/system-0.pcsg"),
+              testing::readFile(c + "/original.pcsg"));
+}
+
 TEST(FuzzCommand, BadArgumentsAreExitStatusTwo) {
     const ChildResult seed = pcsg({"fuzz", "--seed", "banana", "--count", "1"});
     EXPECT_EQ(seed.exitCode, 2);

@@ -140,7 +140,8 @@ std::string Generator::placement() {
         fmt::format("{}({}, {}, {}) ", moveWord, n(-600, 600), n(-600, 600), n(-600, 600));
     if (rng_.percent(60)) s += rotation();
     if (rng_.percent(50))
-        s += fmt::format("scale({}, {}, {}) ", n(150, 700), n(150, 700), n(150, 700));
+        s += fmt::format("scale({}, {}, {}) ", n(150, 700), n(150, 700),
+                         rng_.percent(10) ? n(-700, -150) : n(150, 700));  // a mirror too
     else
         s += fmt::format("uscale({}) ", n(150, 650));
     return s;
@@ -159,7 +160,9 @@ std::string Generator::primitive() {
         case 4:
             return "tetrahedron";
         case 5:
-            return fmt::format("torus({}, {})", n(600, 1000), n(120, 400));
+            // Sometimes a spindle torus (r > R), which intersects itself.
+            return rng_.percent(15) ? fmt::format("torus({}, {})", n(300, 600), n(650, 800))
+                                    : fmt::format("torus({}, {})", n(600, 1000), n(120, 400));
         default:
             return rng_.percent(50) ? "sphere" : fmt::format("torus(0.8, 0.2 + 0.15 * rand())");
     }
@@ -208,6 +211,7 @@ std::string Generator::leaf(bool solid) {
         return call(m);
     }
     if (!solid && modules_[size_t(current_)].triangles && rng_.percent(35)) return triangleLeaf();
+    if (rng_.percent(3)) return "empty";  // which the exporter folds away
     return solidLeaf();
 }
 
@@ -304,6 +308,9 @@ std::string Generator::moduleText(int m) {
 
 std::string Generator::materialsText() {
     std::string s;
+    if (rng_.percent(20))
+        s += fmt::format("material default {{ color {}  diffuse {}  phong {} }}\n", vec(300, 1000),
+                         n(300, 900), n(0, 600));
     for (int k = 0; k < materials_; ++k) {
         s += fmt::format("material m{} {{ color {}  ambient {}  diffuse {}", k, vec(150, 1000),
                          n(0, 300), n(300, 900));
