@@ -85,7 +85,8 @@ void statementEdits(const Tree& base, std::vector<Edit>& edits) {
     }
 }
 
-// Edits of CSG nodes, from the last built (the outermost) to the first.
+// Edits of CSG nodes, from the last built to the first (in a statement, the outermost
+// first).
 void nodeEdits(const Tree& base, std::vector<Edit>& edits) {
     for (size_t x = base.ast.csg.size(); x-- > 0;) {
         const CsgNode& n = base.ast.csg[x];
@@ -139,6 +140,59 @@ void numberEdits(const Tree& base, std::vector<Edit>& edits) {
     }
 }
 
+// The module, definition and material names the CSG under `root` names.
+void namesUnder(const Tree& t, uint32_t root, std::set<std::string>& names) {
+    std::vector<uint32_t> stack = {root};
+    while (!stack.empty()) {
+        const CsgNode& n = t.ast.csg[stack.back()];
+        stack.pop_back();
+        if (n.kind == CsgKind::Name || n.kind == CsgKind::Call || n.kind == CsgKind::Paint)
+            names.insert(std::string(t.spelled(n.nameTok)));
+        if (n.kind == CsgKind::Operator)
+            for (uint32_t k = 0; k < n.count; ++k) stack.push_back(t.ast.lists[n.first + k]);
+        else if (n.child != kNoNode)
+            stack.push_back(n.child);
+    }
+}
+
+bool isAxiom(const Stmt& s) {
+    return s.kind == StmtKind::AxiomA || s.kind == StmtKind::AxiomB;
+}
+
+// What the axiom reaches: the names of modules, definitions and materials it uses,
+// directly or through the rules and definitions it uses.
+std::set<std::string> reachedNames(const Tree& t) {
+    std::set<std::string> names = {"default"};
+    size_t before = 0;
+    do {
+        before = names.size();
+        for (const Stmt& s : t.ast.stmts) {
+            if (s.body == kNoNode || s.kind == StmtKind::Directive) continue;
+            if (isAxiom(s) || names.count(std::string(t.spelled(s.nameTok))))
+                namesUnder(t, s.body, names);
+        }
+    } while (names.size() != before);
+    return names;
+}
+
+// One edit that drops every module, definition and material the axiom does not reach
+// (which may still change the picture: rand() call sites are numbered in file order).
+std::optional<std::string> dropUnreached(const std::string& text) {
+    std::optional<Tree> t = parseTree(text);
+    if (!t) return std::nullopt;
+    const std::set<std::string> reached = reachedNames(*t);
+    std::vector<Stmt> kept;
+    for (const Stmt& s : t->ast.stmts) {
+        const bool named = s.kind == StmtKind::Module || s.kind == StmtKind::RuleA ||
+                           s.kind == StmtKind::RuleB || s.kind == StmtKind::Definition ||
+                           (s.kind == StmtKind::Directive && s.directive == Kw::Material);
+        if (!named || reached.count(std::string(t->spelled(s.nameTok)))) kept.push_back(s);
+    }
+    if (kept.size() == t->ast.stmts.size()) return std::nullopt;
+    t->ast.stmts = std::move(kept);
+    return printTree(*t);
+}
+
 }  // namespace
 
 std::vector<std::string> shrinkCandidates(const std::string& text) {
@@ -150,6 +204,10 @@ std::vector<std::string> shrinkCandidates(const std::string& text) {
     numberEdits(*base, edits);
     std::vector<std::string> out;
     std::set<std::string> seen = {text};
+    if (std::optional<std::string> pruned = dropUnreached(text)) {
+        seen.insert(*pruned);
+        out.push_back(std::move(*pruned));
+    }
     for (const Edit& edit : edits) {
         Tree t = *base;
         edit(t);
@@ -187,6 +245,9 @@ ShrinkResult shrinkSystem(const std::string& text, const StillFails& stillFails,
         ++r.accepted;
         sinceProgress = 0;
         candidates = shrinkCandidates(r.text);
+        // Dropping what is no longer reached (the first candidate when there is any) is
+        // worth trying at once after every step.
+        if (!candidates.empty() && dropUnreached(r.text) == candidates.front()) next = 0;
     }
     return r;
 }

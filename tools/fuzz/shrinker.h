@@ -3,6 +3,7 @@
 // predicate still holds ("the renderers still disagree").
 //
 // The reductions, tried in this order (bigger cuts first):
+//  - drop everything the axiom no longer reaches (modules, definitions, materials);
 //  - drop a statement: a light, the background, a material, the settings, a definition,
 //    a notation-B rule, or a module with all its rules;
 //  - replace a CSG node by `empty`, an operator by one of its operands, drop one operand

@@ -39,6 +39,23 @@ TEST(FuzzShrinker, CandidatesCompileAndAreSmallerSteps) {
     EXPECT_FALSE(has("light { position <1, 2, 3> }\n{d = 2} (S ∪ cube)\n"));
 }
 
+TEST(FuzzShrinker, FirstDropsWhatTheAxiomNoLongerReaches) {
+    const std::string text =
+        "material a { diffuse 0.5 }\nmaterial b { diffuse 0.2 }\n"
+        "{d = 2} paint(a) (T ∪ cube)\nT = U\nU = sphere\n"
+        "S if(d > 0, 2, 1)\n1: S -> paint(b) sphere\n2: S -> {d = d - 1} S\n";
+    const std::vector<std::string> c = shrinkCandidates(text);
+    ASSERT_FALSE(c.empty());
+    EXPECT_EQ(c.front(), format("material a { diffuse 0.5 }\n{d = 2} paint(a) (T ∪ cube)\n"
+                                "T = U\nU = sphere\n"));
+    // Nothing is unreached now: the first candidate edits a CSG node and keeps every
+    // statement.
+    const std::vector<std::string> next = shrinkCandidates(c.front());
+    ASSERT_FALSE(next.empty());
+    EXPECT_NE(next.front().find("material a"), std::string::npos) << next.front();
+    EXPECT_NE(next.front().find("T = U\nU = "), std::string::npos) << next.front();
+}
+
 TEST(FuzzShrinker, ReducesAGeneratedSystemToTheFailingPart) {
     // "Fails" while the scene has a torus: the minimal case is the axiom reduced to
     // one torus, with the camera (which is never dropped) and nothing else.
