@@ -35,6 +35,7 @@ namespace {
 
 struct FuzzOptions : SceneVerifyOptions {
     int count = 0;
+    int first = 0;  // --first: the number of the first system (to rerun one of a campaign)
     double minutes = 0;
     std::string seedText;  // decimal or 0x hex; none: from the time
     std::string outDir;
@@ -209,7 +210,7 @@ int generateOnly(const FuzzOptions& o) {
     const fs::path root = o.outDir.empty() ? fs::path(".") : fs::path(o.outDir);
     std::error_code ec;
     fs::create_directories(root, ec);
-    for (int i = 0; i < std::max(o.count, 1); ++i) {
+    for (int i = o.first; i < o.first + std::max(o.count, 1); ++i) {
         const fs::path file = root / fmt::format("system-{}.pcsg", i);
         if (!writeText(file, fuzz::generateSystem(fuzz::systemSeed(c.seed, uint64_t(i))))) {
             std::cerr << "pcsg fuzz: cannot write " << file.string() << "\n";
@@ -234,7 +235,7 @@ int runFuzz(FuzzOptions o) {
                           o.count > 0 ? fmt::format("{} system(s)", o.count)
                                       : fmt::format("for {} minute(s)", o.minutes),
                           o.width, o.height, o.ss, c.root.string());
-    for (int i = 0; o.count == 0 || i < o.count; ++i) {
+    for (int i = o.first; o.count == 0 || i < o.first + o.count; ++i) {
         if (o.minutes > 0 && elapsed() > o.minutes * 60) break;
         runSystem(i, o, c);
     }
@@ -281,6 +282,9 @@ void addFuzzCommand(CLI::App& app, int& status) {
     cmd->add_option("--count", o->count, "Run N systems (default 20)")->check(CLI::PositiveNumber);
     cmd->add_option("--minutes", o->minutes, "Run for M minutes (with --count: whichever first)")
         ->check(CLI::PositiveNumber);
+    cmd->add_option("--first", o->first,
+                    "Start at system I of the campaign (to rerun one: --first I --count 1)")
+        ->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", o->seedText,
                     "The campaign's seed, decimal or 0x hex (default: from the time; printed)");
     cmd->add_option("--width", o->width, "Image width after reduction")

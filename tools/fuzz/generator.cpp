@@ -160,9 +160,10 @@ std::string Generator::primitive() {
         case 4:
             return "tetrahedron";
         case 5:
-            // Sometimes a spindle torus (r > R), which intersects itself.
-            return rng_.percent(15) ? fmt::format("torus({}, {})", n(300, 600), n(650, 800))
-                                    : fmt::format("torus({}, {})", n(600, 1000), n(120, 400));
+            // Always r < R: POV-Ray 3.7 gives a spindle torus (r > R) the inner sheet of
+            // its quartic as a surface, which shows inside CSG, where the native tracer
+            // (rightly) sees none (docs/fuzz.md, "POV-Ray's spindle tori").
+            return fmt::format("torus({}, {})", n(600, 1000), n(120, 400));
         default:
             return rng_.percent(50) ? "sphere" : fmt::format("torus(0.8, 0.2 + 0.15 * rand())");
     }
