@@ -602,4 +602,12 @@ std::optional<std::string> formatScene(std::string_view fileName, std::string_vi
     return out.take();
 }
 
+std::string printSyntaxTree(const Source& src, const std::vector<Token>& tokens, const Ast& ast) {
+    const BraceComments none;
+    const Printer printer(src, tokens, ast, none);
+    std::string out;
+    for (const Stmt& s : ast.stmts) out += printer.statement(s) + "\n";
+    return out;
+}
+
 }  // namespace pcsg

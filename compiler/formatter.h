@@ -24,7 +24,9 @@
 #include <string>
 #include <string_view>
 
+#include "ast.h"
 #include "diagnostics.h"
+#include "lexer.h"
 
 namespace pcsg {
 
@@ -35,5 +37,11 @@ inline constexpr size_t kFormatIndent = 4;
 // does not compile (or uses #define). `text` must outlive `diags`.
 std::optional<std::string> formatScene(std::string_view fileName, std::string_view text,
                                        Diagnostics& diags);
+
+// The statements of a syntax tree printed as formatScene prints them, one a line, without
+// comments: for tools that edit a parsed tree and print it back (pcsg fuzz's shrinker).
+// `src` and `tokens` are those the tree's token indices refer to; an edited tree may use
+// tokens of its own appended after the End token, whose text lies in `src`.
+std::string printSyntaxTree(const Source& src, const std::vector<Token>& tokens, const Ast& ast);
 
 }  // namespace pcsg

@@ -334,11 +334,26 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_
         case PrimitiveKind::Cylinder:
         case PrimitiveKind::Cone:
         case PrimitiveKind::Tetrahedron:
-        case PrimitiveKind::Plane:
             o.put("{}{}", indent, primitiveInfo(p.kind).pov);
             tex();
             putMatrix(o, p.toWorld);
             break;
+        case PrimitiveKind::Plane: {
+            // In world coordinates, without a matrix: POV-Ray 3.7 cuts CSG wrongly next
+            // to a plane given a `matrix` (even a uniform scale, which `scale` does
+            // right), so the exporter writes the plane's world normal and distance.
+            // z <= 0 in object space is m.p <= m.t in world space, m the third row of
+            // the inverse of L.
+            const Affine inv = p.toWorld.inverse();
+            const Vec3 m{inv.l[2][0], inv.l[2][1], inv.l[2][2]};
+            const Vec3 n = m * (1.0 / length(m));
+            o.put("{}plane{{", indent);
+            o.vec(n);
+            o.put(",");
+            o.num(dot(n, p.toWorld.t));
+            tex();
+            break;
+        }
         case PrimitiveKind::Torus:
             o.put("{}torus{{", indent);
             o.num(t.args[p.firstArg]);

@@ -1,7 +1,7 @@
 // The subcommands of `pcsg`, one file each in tools/cli/: check_command.cpp,
 // graph_command.cpp, render_command.cpp, export_command.cpp (export-pov),
-// stats_command.cpp, verify_command.cpp, bench_command.cpp. Each adds its subcommand to the app and
-// runs it when selected.
+// stats_command.cpp, verify_command.cpp, bench_command.cpp, fmt_command.cpp, fuzz_command.cpp. Each
+// adds its subcommand to the app and runs it when selected.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -18,5 +18,6 @@ void addStatsCommand(CLI::App& app, int& status);   // stats
 void addVerifyCommand(CLI::App& app, int& status);  // verify
 void addBenchCommand(CLI::App& app, int& status);   // bench
 void addFmtCommand(CLI::App& app, int& status);     // fmt
+void addFuzzCommand(CLI::App& app, int& status);    // fuzz
 
 }  // namespace pcsg::tools

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     pcsg::tools::addVerifyCommand(app, status);
     pcsg::tools::addBenchCommand(app, status);
     pcsg::tools::addFmtCommand(app, status);
+    pcsg::tools::addFuzzCommand(app, status);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
