@@ -2,7 +2,8 @@
 // whatever it walks for (docs/language.md sections 3 to 6).
 //
 // A walker carries a PathState down the graph: the parameter frame, the instance path, the
-// S-node depth and the innermost material. Entering a node gives the node to go on to and
+// S-node depth, the innermost material and, where patterns need it, a handle on the frame
+// of the paint node that set that material. Entering a node gives the node to go on to and
 // the state there:
 //
 //  - an S-node checks max_depth, selects its rule (the instance path records which) and
@@ -11,7 +12,10 @@
 //  - a T-node leads to its operand through its matrix; a chain of T-nodes whose arguments
 //    are all constants counts as one step with the chain's product and its inverse,
 //    computed once here;
-//  - a paint node sets the material;
+//  - a paint node sets the material and clears the paint frame; a walker that shades
+//    patterns (docs/language.md section 10: a pattern lives in the frame of the paint node
+//    that applied it) then records that node's frame its own way and puts its handle in
+//    `paint`. Walkers that only need geometry leave it 0 and pay nothing;
 //  - an operator's operand i gets the instance path extended by i (operand());
 //  - a primitive's arguments come from primitiveArgs().
 //
@@ -36,6 +40,7 @@ struct PathState {
     uint64_t path = kRootPath;      // the instance path (docs/language.md section 6)
     uint32_t depth = 0;             // S-nodes passed on the way here
     uint32_t material = 0;          // the innermost paint so far (0: the default)
+    uint32_t paint = 0;  // the walker's handle on that paint node's frame (0: not recorded)
 };
 
 // Where entering a unary node (S, C, T, paint) leads.
@@ -102,6 +107,7 @@ class Semantics {
                 break;
             case NodeKind::Paint:
                 step.state.material = node.payload;
+                step.state.paint = 0;
                 step.child = g_.child(n);
                 break;
             case NodeKind::Operator:
@@ -118,7 +124,7 @@ class Semantics {
 
     // The state of operand i of an operator.
     static PathState operand(const PathState& s, uint32_t i) {
-        return PathState{s.frame, pathChild(s.path, i), s.depth, s.material};
+        return PathState{s.frame, pathChild(s.path, i), s.depth, s.material, s.paint};
     }
 
     // A primitive's argument values in state s, into out[0..8]; returns their number

@@ -5,6 +5,9 @@
 //  - povexport/expander.cpp: the expanded CSG tree, and the counting pass that sizes it;
 //  - tracer/instance_boxes.cpp: the exact bounding box of one S-node instance.
 //
+// Paint frames (PathState::paint) stay 0 here: the exporter writes a texture where its
+// paint node is, so POV-Ray evaluates a pattern in that node's frame itself.
+//
 // No recursion on the C++ stack, whatever the graph's depth: max_depth bounds the
 // S-node depth, and between two S-nodes a path is acyclic, so the walk's own stack is
 // bounded by (max_depth + 1) * nodes.

@@ -37,6 +37,7 @@ struct Hit {
     uint32_t material = 0;
     bool valid = false;  // a surface was found
     uint64_t key = 0;    // the instance path of what was hit: breaks ties in t
+    uint32_t paint = 0;  // the tracer's handle on the frame of the material's paint node
 };
 
 // Does a surface at t from the instance `key` replace the nearest one so far (at tmax)?
@@ -103,7 +104,7 @@ inline bool boundaryHit(const std::vector<Span>& spans, size_t base, size_t coun
         else
             continue;
         if (!nearer(b->t, key, tmax, hit)) return false;
-        hit = Hit{b->t, b->normal, b->material, true, key};
+        hit = Hit{b->t, b->normal, b->material, true, key, b->paint};
         return true;
     }
     return false;

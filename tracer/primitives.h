@@ -21,6 +21,7 @@ struct Boundary {
     Vec3 normal;  // outward normal of the solid that owns this boundary, in the frame of the
                   // node that last handled it; zero at an infinite end
     uint32_t material = 0;
+    uint32_t paint = 0;  // the tracer's handle on the frame of the material's paint node
 };
 
 struct Span {

@@ -4,7 +4,7 @@ namespace pcsg::tracer {
 
 namespace {
 Boundary flipped(const Boundary& b) {
-    return Boundary{b.t, -b.normal, b.material};
+    return Boundary{b.t, -b.normal, b.material, b.paint};
 }
 }  // namespace
 

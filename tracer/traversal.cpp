@@ -151,8 +151,9 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     frames_.reset();
     spans_.clear();
     order_.clear();
+    paintRays_.clear();
     if (g_.axiom == kNone) return false;
-    const Ctx c{rootFrame_.data(), kRootPath, 0, 0};
+    const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
     if (scene_.useBounds) {
         double t0 = tmin, t1 = tmax;
@@ -164,6 +165,11 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     out.t = hit.t;
     out.normal = hit.normal;
     out.material = hit.material;
+    out.painted = hit.paint != 0;
+    if (out.painted) {
+        const LocalRay& p = paintRays_[hit.paint - 1];
+        out.paintPoint = p.o + p.d * hit.t;
+    }
     return true;
 }
 
@@ -207,7 +213,11 @@ template <class Below, class Unrolled, class TransformBack>
         }
     }
     if (kind == NodeKind::Calc) scratch.frame = frames_.push();
-    const Step st = sem.enter(n, c, scratch);
+    Step st = sem.enter(n, c, scratch);
+    if (kind == NodeKind::Paint && !anyHit_ && scene_.paintFrameOf(st.state.material)) {
+        paintRays_.push_back(r);  // a paint node keeps the frame: r is the ray in its frame
+        st.state.paint = static_cast<uint32_t>(paintRays_.size());
+    }
     Result found;
     if (st.inverse) {
         const LocalRay rr{st.inverse->point(r.o), st.inverse->vector(r.d)};
@@ -243,7 +253,7 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                     return first(below, rr, cc, tmin, tmax, hit);
                 },
                 [&](const UnrolledInstance& x, const Ctx& cc) {
-                    return x.first(r, tmin, tmax, hit, {cc.path, cc.material}, anyHit_,
+                    return x.first(r, tmin, tmax, hit, {cc.path, cc.material, cc.paint}, anyHit_,
                                    expansion_->scratch());
                 },
                 [&](const Affine& inv, auto&& walkBelow) {
@@ -283,7 +293,7 @@ bool Tracer::firstOfPrimitive(NodeId n, const LocalRay& r, const Ctx& c, double 
                                std::nextafter(tmax, kInfinity), b) ||
             !nearer(b.t, c.path, tmax, hit))
             return false;
-        hit = Hit{b.t, b.normal, c.material, true, c.path};
+        hit = Hit{b.t, b.normal, c.material, true, c.path, c.paint};
         tmax = b.t;
         return true;
     }
@@ -293,7 +303,7 @@ bool Tracer::firstOfPrimitive(NodeId n, const LocalRay& r, const Ctx& c, double 
         const Boundary* b = s[k].in.t > tmin ? &s[k].in : (s[k].out.t > tmin ? &s[k].out : nullptr);
         if (!b) continue;
         if (!nearer(b->t, c.path, tmax, hit)) return false;
-        hit = Hit{b->t, b->normal, c.material, true, c.path};
+        hit = Hit{b->t, b->normal, c.material, true, c.path, c.paint};
         tmax = b->t;
         return true;
     }
@@ -314,7 +324,7 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
                     return spans(below, rr, cc, tmin, tmax);
                 },
                 [&](const UnrolledInstance& x, const Ctx& cc) {
-                    return x.spans(r, tmin, tmax, spans_, {cc.path, cc.material},
+                    return x.spans(r, tmin, tmax, spans_, {cc.path, cc.material, cc.paint},
                                    expansion_->scratch());
                 },
                 [&](const Affine& inv, auto&& walkBelow) {
@@ -345,6 +355,7 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
             const int count = intersectSolid(p.kind, args, r.o, r.d, s);
             for (int k = 0; k < count; ++k) {
                 s[k].in.material = s[k].out.material = c.material;
+                s[k].in.paint = s[k].out.paint = c.paint;
                 spans_.push_back(s[k]);
             }
             return static_cast<size_t>(count);

@@ -21,6 +21,11 @@
 //  - Small instances that rays keep meeting are expanded once per thread
 //    (unrolled_instances.h) and traced as flat arrays with the same matrices, so the
 //    walk below them finds the same surfaces bit for bit without re-evaluating them.
+//  - Pattern space (docs/language.md section 10): a pattern lives in the frame of the paint
+//    node that applied it. Where a paint node's material has a pattern (only then), the
+//    walk records the ray as that node's frame sees it, and the hit's point in that frame
+//    is that ray at the hit's t (the same number in every frame): no matrix products on
+//    the way, and a scene without patterns records nothing.
 //  - Ties: of two surfaces at exactly the same distance, the one with the smaller
 //    instance path wins, whatever the order the walk found them in. So the image does
 //    not depend on which boxes culled what (and the instance boxes' decisions depend on
@@ -56,6 +61,10 @@ struct SurfaceHit {
     double t = 0;
     Vec3 normal;  // world space, outward from the solid hit, not normalised
     uint32_t material = 0;
+    // Materials with a pattern (TraceScene::paintFrames): the hit point in the frame of the
+    // paint node that applied the material.
+    bool painted = false;
+    Vec3 paintPoint;
 };
 
 // The graph with everything the walk precomputes once: its semantics (with the fused
@@ -85,6 +94,13 @@ class TraceScene {
 
     // What entering each node means (with the fused chains of constant T-nodes).
     const Semantics& semantics() const { return sem_; }
+
+    // Per material: whether a hit needs the point in its paint node's frame (its pigment
+    // has a pattern). Empty: none does, and the walk records no frames.
+    std::vector<uint8_t> paintFrames;
+    bool paintFrameOf(uint32_t material) const {
+        return material < paintFrames.size() && paintFrames[material];
+    }
 
   private:
     friend class Tracer;
@@ -168,6 +184,8 @@ class Tracer {
     std::vector<double> rootFrame_;
     std::vector<Span> spans_;
     std::vector<std::pair<double, uint32_t>> order_;
+    std::vector<LocalRay>
+        paintRays_;  // the ray in the frame of each paint node (PathState::paint - 1)
     bool anyHit_ = false;
     uint64_t visits_ = 0;
     uintptr_t stackLimit_ = 0;

@@ -19,7 +19,8 @@ bool isUnion(const UnrolledInstance::Node& n) {
     return n.kind == UnrolledInstance::Kind::Operator && n.op == CsgOp::Union;
 }
 
-// The expansion took more visits than its depth promised: leave it to the graph walk.
+// The expansion took more visits than its depth promised, or met a paint node whose
+// pattern needs the node's frame: leave it to the graph walk.
 struct TooLarge {};
 
 }  // namespace
@@ -32,7 +33,12 @@ struct TooLarge {};
 class Unroller {
   public:
     Unroller(const TraceScene& scene, UnrolledInstance& out, uint64_t maxVisits)
-        : sem_(scene.semantics()), g_(scene.graph()), out_(out), maxVisits_(maxVisits) {}
+        : scene_(scene),
+          sem_(scene.semantics()),
+          g_(scene.graph()),
+          out_(out),
+          maxVisits_(maxVisits),
+          paintFrames_(!scene.paintFrames.empty()) {}
 
     void run(NodeId select, uint32_t depth, const double* frame, uint64_t path) {
         frames_.emplace_back(frame, frame + g_.slotCount());
@@ -88,6 +94,8 @@ class Unroller {
             scratch.frame = frames_.back().data();
         }
         const Step st = sem_.enter(n, s, scratch);
+        if (kind == NodeKind::Paint && paintFrames_ && scene_.paintFrameOf(st.state.material))
+            throw TooLarge{};
         if (kind == NodeKind::Select) {
             out_.levels_ = std::max(out_.levels_, st.state.depth - base_);
             choices_.push_back(kRuleBit | st.rule);
@@ -257,10 +265,12 @@ class Unroller {
         out_.choices_.insert(out_.choices_.end(), choices_.begin(), choices_.end());
     }
 
+    const TraceScene& scene_;
     const Semantics& sem_;
     const Graph& g_;
     UnrolledInstance& out_;
     const uint64_t maxVisits_;
+    const bool paintFrames_;
     uint64_t visits_ = 0;
     uint32_t base_ = 0;
     std::vector<std::vector<double>> frames_;
@@ -323,6 +333,7 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
     const Node& node = nodes_[n];
     const LocalRay rr = enter(node, r);
     const uint32_t material = node.material == kInherit ? use.material : node.material;
+    const uint32_t paint = node.material == kInherit ? use.paint : 0;
     bool found = false;
     switch (node.kind) {
         case Kind::Solid: {
@@ -336,7 +347,7 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                 if (!(b->t < tmax) &&
                     !(b->t == tmax && hit.valid && keyOf(node, use.path) < hit.key))
                     break;
-                hit = Hit{b->t, b->normal, material, true, keyOf(node, use.path)};
+                hit = Hit{b->t, b->normal, material, true, keyOf(node, use.path), paint};
                 tmax = b->t;
                 found = true;
                 break;
@@ -351,7 +362,7 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                                   std::nextafter(tmax, std::numeric_limits<double>::infinity()),
                                   b) &&
                 (b.t < tmax || (b.t == tmax && hit.valid && keyOf(node, use.path) < hit.key))) {
-                hit = Hit{b.t, b.normal, material, true, keyOf(node, use.path)};
+                hit = Hit{b.t, b.normal, material, true, keyOf(node, use.path), paint};
                 tmax = b.t;
                 found = true;
             }
@@ -429,6 +440,7 @@ size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
             const uint32_t material = node.material == kInherit ? use.material : node.material;
             for (int j = 0; j < k; ++j) {
                 sp[j].in.material = sp[j].out.material = material;
+                sp[j].in.paint = sp[j].out.paint = node.material == kInherit ? use.paint : 0;
                 spans.push_back(sp[j]);
             }
             count = static_cast<size_t>(k);

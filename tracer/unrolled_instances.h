@@ -23,7 +23,10 @@
 //  - Where: per thread (no locks), least recently used first out, within a byte budget.
 //  - Materials and tie-break keys depend on where an instance is used, not on what it
 //    is: a primitive without a paint above it inside the instance takes the caller's
-//    material, and each hit's instance path is replayed from the S-node's path.
+//    material (and the frame of the caller's paint node, for patterns), and each hit's
+//    instance path is replayed from the S-node's path. An instance with a paint node
+//    whose material has a pattern inside is not expanded: the graph walk records that
+//    node's frame.
 #pragma once
 
 #include <cstdint>
@@ -69,10 +72,12 @@ class UnrolledInstance {
         uint32_t first = 0, count = 0;         // leaves: operands in items_
     };
 
-    // Where an instance is used: the S-node's instance path and the material above it.
+    // Where an instance is used: the S-node's instance path, the material above it and the
+    // tracer's handle on its paint node's frame (PathState::paint).
     struct Use {
         uint64_t path;
         uint32_t material;
+        uint32_t paint;
     };
 
     // Scratch space of one thread (stacks of the walk).
