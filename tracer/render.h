@@ -57,7 +57,8 @@ struct RenderOptions {
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
     // Called from worker threads after each tile of each pass (1, or 2 for adaptive
-    // sampling) with the tile's pixel rectangle and the seconds it took; may be empty.
+    // sampling) with the tile's pixel rectangle and the CPU seconds its thread spent on
+    // it (a cost that other load on the machine does not inflate); may be empty.
     std::function<void(int pass, int x0, int y0, int x1, int y1, double seconds)> tileTime;
     // When set and true, the render stops at the next tile and throws RenderCancelled.
     const std::atomic<bool>* cancel = nullptr;
