@@ -16,6 +16,9 @@
 // k names the frame and the clock and keeps the frames written before it. A video (-o
 // OUT.mp4, .webm, .gif) is such a sequence of PNG files encoded by ffmpeg (video.h).
 //
+// Under `mpirun -np N` (or srun) the same command renders on N ranks and writes the same
+// image (distributed_render.h, docs/distributed.md): runRenderCommand() decides.
+//
 // Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
 // run-time error of docs/language.md, reported once with its module path; no image is
 // written); 2 something could not run (bad options, an unwritable output file, no
@@ -699,6 +702,8 @@ void addRenderCommand(CLI::App& app, int& status) {
         "primitives the expanded tree would hold), graph bytes, peak memory and time. A PNG is "
         "written in this process; an EXR or TIFF file by the pcsg-image helper (found beside "
         "pcsg, or in PATH), which gets the pixels through a pipe once they exist.\n"
+        "Under `mpirun -np N pcsg render ...` (or srun) the render is spread over N ranks, "
+        "each using --threads cores, and rank 0 writes the same image (docs/distributed.md).\n"
         "Exit status: 0 written, 1 the scene has an error (nothing written), 2 could not run.");
     cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input)")->required();
     cmd->add_option("-o,--output", o->output,
