@@ -13,6 +13,7 @@ WorkPlan::WorkPlan(int width, int height, std::vector<WorkFrame> frames, int fra
       tilesX_((width + tile - 1) / tile),
       tilesY_((height + tile - 1) / tile),
       ranks_(std::max(1, ranks)),
+      factor_(std::min(kMaxGuidedFactor, 2 * ranks_)),
       framesInSequence_(framesInSequence),
       frames_(std::move(frames)),
       wholeFrames_(static_cast<int>(frames_.size()) >= ranks_),
@@ -29,7 +30,8 @@ std::optional<WorkUnit> WorkPlan::next() {
     if (frameIndex_ >= static_cast<int>(frames_.size())) return std::nullopt;
     const int frameTiles = tilesX_ * tilesY_;
     const int row = tileInFrame_ / tilesX_, col = tileInFrame_ % tilesX_;
-    int64_t take = std::max<int64_t>(1, (tilesLeft_ + 2 * ranks_ - 1) / (2 * ranks_));
+    const int64_t share = static_cast<int64_t>(factor_) * ranks_;
+    int64_t take = std::max<int64_t>(1, (tilesLeft_ + share - 1) / share);
     if (wholeFrames_) take = frameTiles;
     WorkUnit u;
     u.id = nextId_++;

@@ -3,10 +3,15 @@
 //
 //  - Fewer frames than ranks (a still is one frame): each frame is cut into tiles of
 //    kWorkTile x kWorkTile pixels, and a unit is a run of them: whole rows of tiles, or
-//    part of one row. Guided self-scheduling: a unit takes ceil(R / (2 P)) of the R tiles
-//    not yet handed out (P ranks), at least one, within one row unless it takes whole
-//    rows, and never more than its frame has left. So units start large (few messages)
-//    and shrink to single tiles at the end (the ranks finish together).
+//    part of one row. Guided self-scheduling: a unit takes ceil(R / (f P)) of the R tiles
+//    not yet handed out (P ranks, f = min(16, 2 P)), at least one, within one row unless
+//    it takes whole rows, and never more than its frame has left. So units start large
+//    (few messages) and shrink to single tiles at the end (the ranks finish together).
+//    f: the terrain's cost per row varies 30-fold, so with two units in flight per rank
+//    the first units must be a small share of the work or one rank gets too much of the
+//    costly rows; but each unit also recomputes the centres of a one-pixel border
+//    (adaptive sampling), so a few ranks want few units. docs/distributed.md shows the
+//    simulated trade-off.
 //  - As many frames as ranks or more: a unit is a whole frame.
 // Units are handed out in frame order; the first unit of a frame also counts that frame's
 // expansion (the primitive equivalence, and the run-time errors no ray would find).
@@ -20,6 +25,7 @@
 namespace pcsg::tools {
 
 constexpr int kWorkTile = 32;
+constexpr int kMaxGuidedFactor = 16;
 
 struct WorkFrame {
     int frame = 1;     // its number in the sequence (1 for a still)
@@ -52,7 +58,7 @@ class WorkPlan {
     uint64_t framePixels() const { return static_cast<uint64_t>(width_) * height_; }
 
   private:
-    int width_, height_, tile_, tilesX_, tilesY_, ranks_, framesInSequence_;
+    int width_, height_, tile_, tilesX_, tilesY_, ranks_, factor_, framesInSequence_;
     std::vector<WorkFrame> frames_;
     bool wholeFrames_;
     int frameIndex_ = 0, tileInFrame_ = 0, nextId_ = 0;

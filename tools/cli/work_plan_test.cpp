@@ -25,7 +25,7 @@ std::vector<WorkUnit> coverOnce(WorkPlan& plan, int width, int height) {
 }
 
 TEST(WorkPlan, AStillIsCutIntoShrinkingUnitsCoveringEveryPixelOnce) {
-    WorkPlan plan(1000, 700, {{1, 0.0}}, 0, 4);
+    WorkPlan plan(1000, 700, {{1, 0.0}}, 0, 2);
     const auto units = coverOnce(plan, 1000, 700);
     ASSERT_GT(units.size(), 8u);
     EXPECT_EQ(units.front().count, 1);
@@ -36,13 +36,19 @@ TEST(WorkPlan, AStillIsCutIntoShrinkingUnitsCoveringEveryPixelOnce) {
     EXPECT_EQ(plan.totalPixels(), 700000u);
 }
 
-TEST(WorkPlan, TwoRanksTakeAQuarterOfWhatIsLeftWithinARow) {
+TEST(WorkPlan, TwoRanksTakeAnEighthOfWhatIsLeftWithinARow) {
     WorkPlan plan(64, 64, {{1, 0.0}}, 0, 2, 16);  // 4 x 4 tiles
     const auto units = coverOnce(plan, 64, 64);
-    // ceil(left / 4): 4 (a whole row), 3, then 3 cut at the row's end to 1, 2, 2, 1...
+    // ceil(left / (f P)) with f = min(16, 2 P) = 4: 2, 2, 2, 2, then single tiles.
     std::vector<uint64_t> tiles;
     for (const WorkUnit& u : units) tiles.push_back(u.pixels() / 256);
-    EXPECT_EQ(tiles, (std::vector<uint64_t>{4, 3, 1, 2, 2, 1, 1, 1, 1}));
+    EXPECT_EQ(tiles, (std::vector<uint64_t>{2, 2, 2, 2, 1, 1, 1, 1, 1, 1, 1, 1}));
+}
+
+TEST(WorkPlan, ManyRanksStartWithSmallUnits) {
+    // 64 ranks: f = 16, so the first unit is 1/1024 of the frame's 120 x 68 tiles.
+    WorkPlan plan(3840, 2160, {{1, 0.0}}, 0, 64);
+    EXPECT_EQ(plan.next()->pixels(), 8u * kWorkTile * kWorkTile);
 }
 
 TEST(WorkPlan, OneRankTakesTheWholeFrame) {
