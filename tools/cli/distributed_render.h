@@ -11,8 +11,8 @@
 //    threads keep the cores.
 //  - Errors: a run-time error of the scene, on any rank, reaches rank 0, which prints it
 //    once; every rank then exits with its status. A rank that dies ends the whole job:
-//    mpirun kills the others and names the rank (rank 0 writes the image to a temporary
-//    file and renames it, so no partial image is left).
+//    mpirun kills the others and names the rank (the image writers write a temporary
+//    file and rename it, and only once every pixel is in, so no partial image is left).
 #pragma once
 
 #include <functional>

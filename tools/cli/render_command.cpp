@@ -121,43 +121,19 @@ struct RenderReport {
 
 // Writes the pixels: a PNG here, an EXR or TIFF through pcsg-image. Returns the error
 // message, empty on success.
-// `text` with every `from` replaced by `to`.
-std::string replaceAll(std::string text, const std::string& from, const std::string& to) {
-    for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
-        text.replace(at, from.size(), to);
-    return text;
-}
-
-// The file is written under a temporary name beside it and renamed once complete, so a
-// run that is killed (a rank of a distributed render that dies) leaves no partial image.
-// Error messages name the output, not the temporary file.
 std::string writeOutput(const RenderCommandOptions& o, const std::string& imageHelper,
                         RenderReport& report) {
     const auto start = std::chrono::steady_clock::now();
     const std::span<const float> rgb = report.result.rgb;
-    const std::filesystem::path out(o.output);
-    const std::string temp =
-        (out.parent_path() / fmt::format(".pcsg-{}-{}", getpid(), out.filename().string()))
-            .string();
     if (imageFormatOf(o.output) == ImageFormat::png) {
         try {
-            writePng(temp, o.width, o.height, rgb);
+            writePng(o.output, o.width, o.height, rgb);
         } catch (const std::runtime_error& e) {
-            std::remove(temp.c_str());
-            return replaceAll(e.what(), temp, o.output);
+            return e.what();
         }
     } else {
-        report.helper = writeImageWithHelper(imageHelper, temp, o.width, o.height, rgb);
-        if (!report.helper->ok) {
-            std::remove(temp.c_str());
-            return replaceAll(report.helper->error, temp, o.output);
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(temp, o.output, ec);
-    if (ec) {
-        std::remove(temp.c_str());
-        return fmt::format("cannot write '{}': {}", o.output, ec.message());
+        report.helper = writeImageWithHelper(imageHelper, o.output, o.width, o.height, rgb);
+        if (!report.helper->ok) return report.helper->error;
     }
     report.imageWriteSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
