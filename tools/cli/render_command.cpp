@@ -78,7 +78,7 @@ struct RenderCommandOptions {
     bool cyclic = false;
     double fps = 24;          // a video's frame rate
     bool keepFrames = false;  // a video's frames are kept next to it
-    std::string tileTimes;    // --tile-times FILE: each tile's render time, as CSV
+    std::string tileTimes;    // --tile-times FILE: each tile's CPU time, as CSV
     // Rank 0 of `mpirun -np N pcsg render` (N > 1): the ranks render the pixels.
     DistributedRender* distributed = nullptr;
 };
@@ -154,7 +154,7 @@ tracer::RenderOptions tracerOptions(const RenderCommandOptions& o) {
     return ro;
 }
 
-// --tile-times FILE: every tile's render time, for the scaling model of
+// --tile-times FILE: every tile's CPU time, for the scaling model of
 // docs/distributed.md (tools/dev/mpi_schedule_sim.py reads it).
 class TileTimes {
   public:
@@ -732,7 +732,8 @@ void addRenderCommand(CLI::App& app, int& status) {
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--tile-times", o->tileTimes,
-                    "Write every tile's render time to FILE as CSV (pass,x0,y0,x1,y1,seconds), "
+                    "Write every tile's cost (its thread's CPU seconds) to FILE as CSV "
+                    "(pass,x0,y0,x1,y1,seconds), "
                     "for tools/dev/mpi_schedule_sim.py (docs/distributed.md); one process only")
         ->group("");  // hidden: a measuring tool
     cmd->callback([o, &status] { status = runRenderCommand(*o); });
