@@ -5,6 +5,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -60,6 +61,13 @@ void runWithStack(size_t stackBytes, F& f) {
     if (ctx.error) std::rethrow_exception(ctx.error);
 }
 
+// The calling thread's CPU time: a tile's cost, whatever else runs on the machine.
+double threadCpuSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + ts.tv_nsec * 1e-9;
+}
+
 double aaEncode(double c) {
     return c > 0 ? std::pow(c, 1.0 / 2.5) : 0.0;
 }
@@ -75,87 +83,125 @@ struct Worker {
     Shader shader;
 };
 
-// One render of the image in tiles of kTile x kTile pixels on oneTBB's threads: pass 1
-// takes the stratified samples (or the pixel centres), pass 2 of adaptive sampling
-// supersamples where a pixel differs from a 4-neighbour. The first error stops the rest.
+using Workers = tbb::enumerable_thread_specific<std::unique_ptr<Worker>>;
+
+// One render of a region of the image in tiles of kTile x kTile pixels on oneTBB's
+// threads: pass 1 takes the stratified samples (or the pixel centres) of the region and,
+// with adaptive sampling, of a one-pixel border around it (clipped to the image); pass 2
+// supersamples where a pixel of the region differs from a 4-neighbour. The first error
+// stops the rest. The pixels are the same whatever the region: each depends only on its
+// own samples and its neighbours' centres.
 class TileRender {
   public:
     TileRender(const TraceScene& scene, const PinholeCamera& camera, const RenderOptions& opt,
-               RenderResult& result)
+               Workers& workers, const Region& region)
         : scene_(scene),
           camera_(camera),
           opt_(opt),
-          result_(result),
+          workers_(workers),
           w_(opt.width),
           h_(opt.height),
-          tilesX_((w_ + kTile - 1) / kTile),
-          tiles_(tilesX_ * ((h_ + kTile - 1) / kTile)),
-          totalWork_(opt.adaptive > 0 ? 2 * tiles_ : tiles_) {
-        result_.rgb.assign(static_cast<size_t>(w_) * h_ * 3, 0.0f);
+          region_(region),
+          halo_(opt.adaptive > 0 ? Region{std::max(0, region.x0 - 1), std::max(0, region.y0 - 1),
+                                          std::min(w_, region.x1 + 1), std::min(h_, region.y1 + 1)}
+                                 : region),
+          totalWork_(tileCount(halo_) + (opt.adaptive > 0 ? tileCount(region_) : 0)) {
+        rgb_.assign(halo_.pixels() * 3, 0.0f);
     }
 
-    // Runs both passes on the calling thread's pool; rethrows the first error.
-    void run(size_t stackBytes) {
+    // Runs both passes on the calling thread's pool and returns the region's pixels;
+    // rethrows the first error.
+    std::vector<float> run(size_t stackBytes) {
         std::unique_ptr<tbb::global_control> limit;
         if (opt_.threads > 0)
             limit = std::make_unique<tbb::global_control>(
                 tbb::global_control::max_allowed_parallelism, static_cast<size_t>(opt_.threads));
         tbb::global_control stackSize(tbb::global_control::thread_stack_size, stackBytes);
-        forTiles([&](Worker& wk, int x, int y) { samplePixel(wk, x, y); });
+        forTiles(1, halo_, [&](Worker& wk, int x, int y) { samplePixel(wk, x, y); });
         if (opt_.adaptive > 0 && !stop_) {
-            const std::vector<float> centres = result_.rgb;
-            forTiles([&](Worker& wk, int x, int y) { supersamplePixel(wk, centres, x, y); });
+            const std::vector<float> centres = rgb_;
+            forTiles(2, region_,
+                     [&](Worker& wk, int x, int y) { supersamplePixel(wk, centres, x, y); });
         }
-        for (auto& wp : workers_)
-            if (wp) {
-                result_.rays += wp->shader.rays();
-                result_.nodeVisits += wp->shader.nodeVisits();
-                result_.expansions += wp->shader.tracer().expansions();
-            }
         if (firstError_) std::rethrow_exception(firstError_);
+        if (stop_) throw RenderCancelled();
+        return regionPixels();
     }
 
   private:
-    // Runs pixel(worker, x, y) over every pixel, tile by tile in parallel.
+    static int tileCount(const Region& r) {
+        return ((r.width() + kTile - 1) / kTile) * ((r.height() + kTile - 1) / kTile);
+    }
+
+    // The region's rows out of the buffer (the buffer itself when there is no border).
+    std::vector<float> regionPixels() {
+        if (halo_.x0 == region_.x0 && halo_.y0 == region_.y0 && halo_.x1 == region_.x1 &&
+            halo_.y1 == region_.y1)
+            return std::move(rgb_);
+        std::vector<float> out(region_.pixels() * 3);
+        const size_t row = static_cast<size_t>(region_.width()) * 3;
+        for (int y = region_.y0; y < region_.y1; ++y)
+            std::copy_n(pixelAt(rgb_, region_.x0, y), row,
+                        out.data() + static_cast<size_t>(y - region_.y0) * row);
+        return out;
+    }
+
+    // Runs pixel(worker, x, y) over every pixel of the area, tile by tile in parallel.
     template <class Pixel>
-    void forTiles(Pixel&& pixel) {
+    void forTiles(int pass, const Region& area, Pixel&& pixel) {
+        const int tilesX = (area.width() + kTile - 1) / kTile;
         tbb::parallel_for(
-            tbb::blocked_range<int>(0, tiles_, 1),
+            tbb::blocked_range<int>(0, tileCount(area), 1),
             [&](const tbb::blocked_range<int>& range) {
-                for (int tile = range.begin(); tile != range.end(); ++tile)
-                    if (!runTile(tile, pixel)) return;
+                for (int tile = range.begin(); tile != range.end(); ++tile) {
+                    const int x0 = area.x0 + (tile % tilesX) * kTile;
+                    const int y0 = area.y0 + (tile / tilesX) * kTile;
+                    const Region t{x0, y0, std::min(area.x1, x0 + kTile),
+                                   std::min(area.y1, y0 + kTile)};
+                    if (!runTile(pass, t, pixel)) return;
+                }
             },
             tbb::simple_partitioner());
     }
 
     // One tile; false when the render stops (an error here or elsewhere).
     template <class Pixel>
-    bool runTile(int tile, Pixel& pixel) {
+    bool runTile(int pass, const Region& t, Pixel& pixel) {
         if (stop_.load(std::memory_order_relaxed)) return false;
+        if (opt_.cancel && opt_.cancel->load(std::memory_order_relaxed)) {
+            stop_ = true;
+            return false;
+        }
         auto& wp = workers_.local();
         if (!wp) wp = std::make_unique<Worker>(scene_);
-        const int x0 = (tile % tilesX_) * kTile, y0 = (tile / tilesX_) * kTile;
-        const int x1 = std::min(w_, x0 + kTile), y1 = std::min(h_, y0 + kTile);
+        const double start = opt_.tileTime ? threadCpuSeconds() : 0.0;
         try {
-            for (int y = y0; y < y1; ++y)
-                for (int x = x0; x < x1; ++x) pixel(*wp, x, y);
+            for (int y = t.y0; y < t.y1; ++y)
+                for (int x = t.x0; x < t.x1; ++x) pixel(*wp, x, y);
         } catch (...) {
             std::lock_guard<std::mutex> lock(errorMutex_);
             if (!firstError_) firstError_ = std::current_exception();
             stop_ = true;
             return false;
         }
+        if (opt_.tileTime) opt_.tileTime(pass, t.x0, t.y0, t.x1, t.y1, threadCpuSeconds() - start);
         const int d = ++done_;
         if (opt_.progress) opt_.progress(static_cast<double>(d) / totalWork_);
         return true;
     }
 
+    // Pixel (x, y) of the image in the buffer, which holds halo_.
     float* pixelAt(std::vector<float>& rgb, int x, int y) const {
-        return rgb.data() + (static_cast<size_t>(y) * w_ + x) * 3;
+        return rgb.data() +
+               (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
+    }
+    const float* pixelAt(const std::vector<float>& rgb, int x, int y) const {
+        return rgb.data() +
+               (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
     }
 
     void store(int x, int y, const Vec3& c) {
-        float* p = pixelAt(result_.rgb, x, y);
+        float* p = pixelAt(rgb_, x, y);
         p[0] = static_cast<float>(c.x), p[1] = static_cast<float>(c.y),
         p[2] = static_cast<float>(c.z);
     }
@@ -173,13 +219,12 @@ class TileRender {
     // Pass 2 of adaptive sampling (POV-Ray's +A, method 1): a pixel whose centre differs
     // from a 4-neighbour's by the threshold or more gets depth x depth more samples.
     void supersamplePixel(Worker& wk, const std::vector<float>& centres, int x, int y) {
-        const float* c = centres.data() + (static_cast<size_t>(y) * w_ + x) * 3;
+        const float* c = pixelAt(centres, x, y);
         bool differs = false;
         const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
         for (int k = 0; k < 4 && !differs; ++k) {
             if (nx[k] < 0 || nx[k] >= w_ || ny[k] < 0 || ny[k] >= h_) continue;
-            const float* o = centres.data() + (static_cast<size_t>(ny[k]) * w_ + nx[k]) * 3;
-            differs = colourDistance(c, o) >= opt_.adaptive;
+            differs = colourDistance(c, pixelAt(centres, nx[k], ny[k])) >= opt_.adaptive;
         }
         if (!differs) return;
         const int depth = std::max(1, opt_.adaptiveDepth);
@@ -195,9 +240,11 @@ class TileRender {
     const TraceScene& scene_;
     const PinholeCamera& camera_;
     const RenderOptions& opt_;
-    RenderResult& result_;
-    const int w_, h_, tilesX_, tiles_, totalWork_;
-    tbb::enumerable_thread_specific<std::unique_ptr<Worker>> workers_;
+    Workers& workers_;
+    const int w_, h_;
+    const Region region_, halo_;
+    const int totalWork_;
+    std::vector<float> rgb_;  // halo_'s pixels
     std::mutex errorMutex_;
     std::exception_ptr firstError_;
     std::atomic<bool> stop_{false};
@@ -206,33 +253,91 @@ class TileRender {
 
 }  // namespace
 
-RenderResult render(const Graph& g, const RenderOptions& opt) {
-    using Clock = std::chrono::steady_clock;
-    if (opt.width <= 0 || opt.height <= 0)
-        throw std::invalid_argument("image size must be positive");
-    RenderResult result;
-    result.width = opt.width;
-    result.height = opt.height;
-    const auto t0 = Clock::now();
+struct RegionRenderer::State {
+    State(const Graph& g, const RenderOptions& o, Bounds bounds, const InstanceBoxOptions& boxes)
+        : opt(o),
+          scene(g, std::move(bounds), o.instanceBoxes, boxes),
+          camera(g.scene.camera, o.width, o.height) {}
+    const RenderOptions& opt;
+    TraceScene scene;
+    const PinholeCamera camera;
+    Workers workers;
+    RenderResult figures;  // no pixels
+};
+
+namespace {
+
+Bounds boundsFor(const Graph& g, const RenderOptions& opt, RenderResult& figures) {
+    const auto t0 = std::chrono::steady_clock::now();
     BoundsOptions boundsOptions;
     boundsOptions.time = opt.boundsTime;
     Bounds bounds = opt.bounds ? *opt.bounds : computeBounds(g, boundsOptions);
-    result.infiniteBoxes = bounds.infiniteNodes;
-    const auto t1 = Clock::now();
-    result.boundsSeconds = std::chrono::duration<double>(t1 - t0).count();
+    figures.infiniteBoxes = bounds.infiniteNodes;
+    figures.boundsSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return bounds;
+}
+
+InstanceBoxOptions boxOptionsFor(const RenderOptions& opt) {
     InstanceBoxOptions boxOptions;
     boxOptions.maxBytes = opt.instanceBoxBytes;
-    TraceScene scene(g, std::move(bounds), opt.instanceBoxes, boxOptions);
-    scene.useBounds = opt.useBounds;
-    scene.expansionBytesPerThread = opt.expansionBytesPerThread;
-    const PinholeCamera camera(g.scene.camera, opt.width, opt.height);
-    const size_t stack = scene.stackBytesNeeded();
+    return boxOptions;
+}
+
+}  // namespace
+
+RegionRenderer::RegionRenderer(const Graph& g, const RenderOptions& opt) {
+    if (opt.width <= 0 || opt.height <= 0)
+        throw std::invalid_argument("image size must be positive");
+    RenderResult figures;
+    figures.width = opt.width;
+    figures.height = opt.height;
+    Bounds bounds = boundsFor(g, opt, figures);
+    const auto t1 = std::chrono::steady_clock::now();
+    state_ = std::make_unique<State>(g, opt, std::move(bounds), boxOptionsFor(opt));
+    state_->scene.useBounds = opt.useBounds;
+    state_->scene.expansionBytesPerThread = opt.expansionBytesPerThread;
+    figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    state_->figures = figures;
+}
+
+RegionRenderer::~RegionRenderer() = default;
+
+std::vector<float> RegionRenderer::render(const Region& region) {
+    State& s = *state_;
+    if (region.x0 < 0 || region.y0 < 0 || region.x1 > s.opt.width || region.y1 > s.opt.height ||
+        region.width() <= 0 || region.height() <= 0)
+        throw std::invalid_argument("the region is not a non-empty part of the image");
+    const auto t0 = std::chrono::steady_clock::now();
+    const size_t stack = s.scene.stackBytesNeeded();
+    std::vector<float> rgb;
     // The walk recurses once per node visit: the calling thread gets a stack as large as
     // the scene needs, and so do the pool's threads.
-    auto work = [&] { TileRender(scene, camera, opt, result).run(stack); };
+    auto work = [&] { rgb = TileRender(s.scene, s.camera, s.opt, s.workers, region).run(stack); };
     runWithStack(stack, work);
-    if (scene.instanceBoxes()) result.instanceBoxes = scene.instanceBoxes()->stats();
-    result.seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+    s.figures.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return rgb;
+}
+
+RenderResult RegionRenderer::figures() const {
+    const State& s = *state_;
+    RenderResult r = s.figures;
+    for (const auto& wp : s.workers)
+        if (wp) {
+            r.rays += wp->shader.rays();
+            r.nodeVisits += wp->shader.nodeVisits();
+            r.expansions += wp->shader.tracer().expansions();
+        }
+    if (s.scene.instanceBoxes()) r.instanceBoxes = s.scene.instanceBoxes()->stats();
+    return r;
+}
+
+RenderResult render(const Graph& g, const RenderOptions& opt) {
+    RegionRenderer renderer(g, opt);
+    std::vector<float> rgb = renderer.render(Region{0, 0, opt.width, opt.height});
+    RenderResult result = renderer.figures();
+    result.rgb = std::move(rgb);
     return result;
 }
 

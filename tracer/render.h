@@ -18,12 +18,18 @@
 //  - A run-time error of the scene (RuntimeError) stops the render: the first error wins
 //    (later ones from other threads are dropped), the remaining tiles are skipped, and
 //    render() rethrows it. Nothing is written.
+//  - Regions: RegionRenderer renders any rectangle of the image with the pixels render()
+//    gives it (the distributed renderer's ranks render the tiles they are handed). With
+//    adaptive sampling a pixel's pass 2 reads its 4-neighbours' centres, so a region takes
+//    the pass-1 samples of a one-pixel border around itself too.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -55,6 +61,24 @@ struct RenderOptions {
     size_t expansionBytesPerThread = 16u << 20;
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
+    // Called from worker threads after each tile of each pass (1, or 2 for adaptive
+    // sampling) with the tile's pixel rectangle and the CPU seconds its thread spent on
+    // it (a cost that other load on the machine does not inflate); may be empty.
+    std::function<void(int pass, int x0, int y0, int x1, int y1, double seconds)> tileTime;
+    // When set and true, the render stops at the next tile and throws RenderCancelled.
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+struct RenderCancelled : std::runtime_error {
+    RenderCancelled() : std::runtime_error("the render was cancelled") {}
+};
+
+// A rectangle of the image's pixels: [x0, x1) x [y0, y1).
+struct Region {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    size_t pixels() const { return static_cast<size_t>(width()) * height(); }
 };
 
 struct RenderResult {
@@ -72,5 +96,28 @@ struct RenderResult {
 // Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)
 // or std::runtime_error (the stack cannot be made large enough).
 RenderResult render(const Graph& g, const RenderOptions& options);
+
+// The scene made ready once (hyper-bounding boxes, trace scene, camera) and rendered a
+// region at a time, each region's pixels exactly those render() gives them. The graph
+// and options must outlive it.
+class RegionRenderer {
+  public:
+    RegionRenderer(const Graph& g, const RenderOptions& options);
+    ~RegionRenderer();
+    RegionRenderer(const RegionRenderer&) = delete;
+    RegionRenderer& operator=(const RegionRenderer&) = delete;
+
+    // The region's linear RGB, row-major. Throws as render() does; options.progress is
+    // called with the fraction of this region done.
+    std::vector<float> render(const Region& region);
+
+    // The figures so far (no pixels): rays, node visits and expansions of every region,
+    // the bounds' time, and `seconds`, the set-up and every region's render.
+    RenderResult figures() const;
+
+  private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
 
 }  // namespace pcsg::tracer

@@ -149,6 +149,34 @@ double aaDistance(const float* a, const float* b) {
     return d;
 }
 
+// The distributed renderer's ranks render regions: any region's pixels are the whole
+// image's, with adaptive sampling too (a region takes the centres of a one-pixel border,
+// which its edge pixels compare with), and with regions that touch the image's edges.
+TEST(Render, ARegionHasTheWholeImagesPixels) {
+    auto c = compile(kBusyScene);
+    ASSERT_TRUE(c->graph);
+    for (const double adaptive : {0.0, 0.1}) {
+        SCOPED_TRACE(adaptive);
+        RenderOptions o = small(2);
+        o.adaptive = adaptive;
+        const RenderResult whole = render(*c->graph, o);
+        RegionRenderer renderer(*c->graph, o);
+        for (const Region& r : {Region{0, 0, 72, 54}, Region{0, 0, 5, 3}, Region{17, 9, 50, 10},
+                                Region{71, 53, 72, 54}, Region{30, 0, 72, 54}}) {
+            const std::vector<float> rgb = renderer.render(r);
+            ASSERT_EQ(rgb.size(), r.pixels() * 3);
+            for (int y = r.y0; y < r.y1; ++y)
+                ASSERT_EQ(std::memcmp(&rgb[static_cast<size_t>(y - r.y0) * r.width() * 3],
+                                      &whole.rgb[(static_cast<size_t>(y) * 72 + r.x0) * 3],
+                                      static_cast<size_t>(r.width()) * 3 * sizeof(float)),
+                          0)
+                    << "row " << y << " of region " << r.x0 << "," << r.y0;
+        }
+        EXPECT_GT(renderer.figures().rays, 0u);
+        EXPECT_THROW(renderer.render(Region{70, 0, 73, 1}), std::invalid_argument);
+    }
+}
+
 TEST(Render, AdaptiveSupersamplingChangesOnlyPixelsNextToAContrast) {
     auto c = compile(kBusyScene);
     ASSERT_TRUE(c->graph);

@@ -1,7 +1,9 @@
 // pcsg: compile, render, export and verify PCSG scenes. See `pcsg --help`.
 #include <iostream>
+#include <sstream>
 
 #include "commands.h"
+#include "mpi_session.h"
 
 int main(int argc, char** argv) {
     CLI::App app{
@@ -24,7 +26,11 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        // Under mpirun every rank parses the same command line: rank 0 alone prints.
+        std::ostringstream elsewhere;
+        const bool print = pcsg::tools::launcherRank() == 0;
+        return app.exit(e, print ? std::cout : elsewhere, print ? std::cerr : elsewhere) == 0 ? 0
+                                                                                              : 2;
     }
     return status;
 }

@@ -16,6 +16,9 @@
 // k names the frame and the clock and keeps the frames written before it. A video (-o
 // OUT.mp4, .webm, .gif) is such a sequence of PNG files encoded by ffmpeg (video.h).
 //
+// Under `mpirun -np N` (or srun) the same command renders on N ranks and writes the same
+// image (distributed_render.h, docs/distributed.md): runRenderCommand() decides.
+//
 // Exit status: 0 the image was written; 1 the scene is at fault (a compile error or a
 // run-time error of docs/language.md, reported once with its module path; no image is
 // written); 2 something could not run (bad options, an unwritable output file, no
@@ -23,6 +26,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -35,11 +39,13 @@
 #include <vector>
 
 #include "commands.h"
+#include "distributed_render.h"
 #include "eval.h"
 #include "expander.h"
 #include "frames.h"
 #include "image_format.h"
 #include "image_helper.h"
+#include "mpi_session.h"
 #include "png_writer.h"
 #include "render.h"
 #include "scene_input.h"
@@ -73,6 +79,9 @@ struct RenderCommandOptions {
     double fps = 24;                   // a video's frame rate
     bool keepFrames = false;           // a video's frames are kept next to it
     std::string frameBounds = "auto";  // --frame-bounds: auto, on or off
+    std::string tileTimes;             // --tile-times FILE: each tile's CPU time, as CSV
+    // Rank 0 of `mpirun -np N pcsg render` (N > 1): the ranks render the pixels.
+    DistributedRender* distributed = nullptr;
 };
 
 // A progress bar on standard error, redrawn at most every 1%.
@@ -146,6 +155,52 @@ tracer::RenderOptions tracerOptions(const RenderCommandOptions& o) {
     return ro;
 }
 
+// --tile-times FILE: every tile's CPU time, for the scaling model of
+// docs/distributed.md (tools/dev/mpi_schedule_sim.py reads it).
+class TileTimes {
+  public:
+    void add(int pass, int x0, int y0, int x1, int y1, double seconds) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        rows_ += fmt::format("{},{},{},{},{},{:.9f}\n", pass, x0, y0, x1, y1, seconds);
+    }
+    bool write(const std::string& path) const {
+        std::FILE* f = std::fopen(path.c_str(), "w");
+        if (!f) return false;
+        const std::string header = "pass,x0,y0,x1,y1,seconds\n";
+        bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size() &&
+                  std::fwrite(rows_.data(), 1, rows_.size(), f) == rows_.size();
+        return std::fclose(f) == 0 && ok;
+    }
+
+  private:
+    std::mutex mutex_;
+    std::string rows_;
+};
+
+// Rank 0 of a distributed render: the still's pixels from every rank.
+int distributedStill(Graph& g, const RenderCommandOptions& o, const tracer::RenderOptions& ro,
+                     RenderReport& report) {
+    DistributedJob job;
+    job.scene = o.scene;
+    job.render = ro;
+    job.countVisits = o.countVisits;
+    job.frames = {WorkFrame{o.frame, o.clock}};
+    const auto start = std::chrono::steady_clock::now();
+    tracer::RenderResult& r = report.result;
+    const int status = o.distributed->render(g, job, [&](DistributedFrame& f) {
+        r.width = o.width;
+        r.height = o.height;
+        r.rgb = std::move(f.rgb);
+        r.rays = f.rays;
+        r.nodeVisits = f.nodeVisits;
+        r.boundsSeconds = f.boundsSeconds;
+        if (f.count) report.count = *f.count;
+        return 0;
+    });
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return status;
+}
+
 // Counts the expansion and renders; returns the exit status (0, or 1 and 2 with the
 // error printed).
 // What a frame of a sequence adds to a render: a note for its errors, the sequence's
@@ -157,7 +212,7 @@ struct FrameContext {
     double base = 0, share = 1;
 };
 
-int countAndRender(const Graph& g, const RenderCommandOptions& o, RenderReport& report,
+int countAndRender(Graph& g, const RenderCommandOptions& o, RenderReport& report,
                    const FrameContext& frame = {}) {
     // Primitive equivalence: what the expanded tree would hold, counted without building
     // it. The count walks every path of the expansion (memoised), so it also finds the
@@ -170,6 +225,16 @@ int countAndRender(const Graph& g, const RenderCommandOptions& o, RenderReport& 
     if (showProgress)
         ro.progress = [bar, base = frame.base, share = frame.share](double f) {
             bar->update(base + share * f);
+        };
+    if (o.distributed) {
+        const int status = distributedStill(g, o, ro, report);
+        if (showProgress) bar->finish();
+        return status;
+    }
+    auto times = std::make_shared<TileTimes>();
+    if (!o.tileTimes.empty())
+        ro.tileTime = [times](int pass, int x0, int y0, int x1, int y1, double seconds) {
+            times->add(pass, x0, y0, x1, y1, seconds);
         };
     try {
         CountOptions co;
@@ -186,6 +251,10 @@ int countAndRender(const Graph& g, const RenderCommandOptions& o, RenderReport& 
         return 2;
     }
     if (showProgress && !frame.bar) bar->finish();
+    if (!o.tileTimes.empty() && !times->write(o.tileTimes)) {
+        std::cerr << "pcsg render: cannot write '" << o.tileTimes << "'\n";
+        return 2;
+    }
     return 0;
 }
 
@@ -212,6 +281,10 @@ void printJson(const RenderCommandOptions& o, const RenderReport& report) {
     }
     if (!report.count.complete)
         j["primitive_equivalence_note"] = "too large to count (rand/choose)";
+    if (o.distributed) {
+        j["ranks"] = o.distributed->ranks();
+        j["per_rank"] = rankFiguresJson(o.distributed->finish(0));
+    }
     std::cout << j.dump(2) << "\n";
 }
 
@@ -374,6 +447,10 @@ void printFrames(const RenderCommandOptions& o, const FramePlan& plan, const Gra
                        {"range_bounds_seconds", rangeBoundsSeconds},
                        {"cyclic", plan.cyclic}};
         j["graph_nodes"] = g.nodes.size();
+        if (o.distributed) {
+            j["ranks"] = o.distributed->ranks();
+            j["per_rank"] = rankFiguresJson(o.distributed->finish(0));
+        }
         std::cout << j.dump(2) << "\n";
         return;
     }
@@ -381,10 +458,72 @@ void printFrames(const RenderCommandOptions& o, const FramePlan& plan, const Gra
                              done.size(), plan.first, plan.last, plan.frames, seconds);
     s.print(std::cout);
     std::cout << fmt::format("{:<24}{:.3f} s\n", "image write time", writeSeconds);
+    if (o.distributed) std::cout << rankFiguresText(o.distributed->finish(0));
+}
+
+// Rank 0 of a distributed render: writes frame df, which every pixel of has arrived.
+int writeDistributedFrame(const RenderCommandOptions& o, const FramePlan& plan,
+                          DistributedFrame& df, const std::string& imageHelper,
+                          std::vector<FrameFigures>& done) {
+    FrameFigures figures;
+    figures.frame = df.frame.frame;
+    figures.clock = df.frame.clock;
+    RenderCommandOptions fo = o;
+    fo.output = frameFileName(o.output, figures.frame, plan.frames);
+    RenderReport report;
+    report.result.rgb = std::move(df.rgb);
+    if (const std::string error = writeOutput(fo, imageHelper, report); !error.empty()) {
+        std::cerr << "pcsg render: " << error
+                  << fmt::format("\n  at frame {} of {}, clock {}", figures.frame, plan.frames,
+                                 figures.clock)
+                  << "\n";
+        return 2;
+    }
+    figures.output = fo.output;
+    figures.result.rays = df.rays;
+    figures.result.nodeVisits = df.nodeVisits;
+    figures.result.seconds = df.renderSeconds;
+    figures.result.boundsSeconds = df.boundsSeconds;
+    figures.imageWriteSeconds = report.imageWriteSeconds;
+    if (df.count && df.count->complete) figures.primitives = df.count->primitives;
+    if (!o.json)
+        std::cout << fmt::format(
+                         "frame {} of {} (clock {}): wrote {}, {:.3f} s of rendering on "
+                         "the ranks, {} rays\n",
+                         figures.frame, plan.frames, figures.clock, figures.output,
+                         figures.result.seconds, figures.result.rays)
+                  << std::flush;
+    done.push_back(std::move(figures));
+    return 0;
+}
+
+// Rank 0 of a distributed render: the frames, as units of work over every rank.
+int runFramesDistributed(const RenderCommandOptions& o, const FramePlan& plan,
+                         CompiledScene& compiled, const std::string& imageHelper) {
+    DistributedJob job;
+    job.scene = o.scene;
+    job.render = tracerOptions(o);
+    job.countVisits = o.countVisits;
+    job.framesInSequence = plan.frames;
+    for (int f = plan.first; f <= plan.last; ++f) job.frames.push_back({f, frameClock(plan, f)});
+    auto bar = std::make_shared<ProgressBar>();
+    const bool showProgress = isatty(STDERR_FILENO) != 0;
+    if (showProgress) job.render.progress = [bar](double f) { bar->update(f); };
+    std::vector<FrameFigures> done;
+    const int status = o.distributed->render(*compiled.graph, job, [&](DistributedFrame& df) {
+        return writeDistributedFrame(o, plan, df, imageHelper, done);
+    });
+    if (showProgress) bar->finish();
+    if (status != 0) return status;
+    std::sort(done.begin(), done.end(),
+              [](const FrameFigures& a, const FrameFigures& b) { return a.frame < b.frame; });
+    printFrames(o, plan, *compiled.graph, compiled, done, 0.0);  // each rank bounds its frames
+    return 0;
 }
 
 int runFrames(const RenderCommandOptions& o, const FramePlan& plan, CompiledScene& compiled,
               const std::string& imageHelper) {
+    if (o.distributed) return runFramesDistributed(o, plan, compiled, imageHelper);
     Graph& g = *compiled.graph;
     std::vector<FrameFigures> done;
     SequenceBounds bounds(g, plan, o.frameBounds);
@@ -428,11 +567,13 @@ void printText(const RenderCommandOptions& o, const RenderReport& report) {
     else
         std::cout << fmt::format("{:<24}{:.3f} s (libpng, in this process)\n", "image write time",
                                  report.imageWriteSeconds);
+    if (o.distributed) std::cout << rankFiguresText(o.distributed->finish(0));
 }
 
 int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
              const std::string& imageHelper);
 int runRender(const RenderCommandOptions& o);
+int runRenderCommand(RenderCommandOptions& o);
 
 // A video (-o OUT.mp4, .webm, .gif): the frames rendered as PNG files, then encoded by
 // ffmpeg; checked before anything is rendered.
@@ -525,6 +666,38 @@ int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
     return 0;
 }
 
+// Under mpirun or srun (docs/distributed.md): rank 0 runs the command as one process
+// would, with the pixels rendered by every rank; the other ranks render what rank 0 hands
+// them. Without a launcher: one process, no MPI.
+int runRenderCommand(RenderCommandOptions& o) {
+    if (!launchedAsRanks()) return runRender(o);
+    std::string error;
+    const std::unique_ptr<MpiSession> session = MpiSession::start(error);
+    if (!session) {
+        if (launcherRank() == 0) std::cerr << "pcsg render: error: " << error << "\n";
+        return 2;
+    }
+    if (session->size() == 1) return runRender(o);
+    if (session->rank() != 0)
+        return runWorkerRank(*session, o.scene, tracerOptions(o), o.countVisits);
+    DistributedRender distributed(*session);
+    int status = 0;
+    if (o.scene == "-" || !o.tileTimes.empty()) {
+        std::cerr << "pcsg render: error: "
+                  << (o.scene == "-" ? "a distributed render reads the scene from a file (every "
+                                       "rank compiles it), not from standard input"
+                                     : "--tile-times measures one process: run it without mpirun")
+                  << "\n";
+        status = 2;
+    } else {
+        o.distributed = &distributed;
+        status = runRender(o);
+        o.distributed = nullptr;
+    }
+    distributed.finish(status);
+    return status;
+}
+
 // CLI11 validator: the output's extension names an image type pcsg writes.
 const CLI::Validator kImageOutput(
     [](const std::string& path) -> std::string {
@@ -583,6 +756,8 @@ void addRenderCommand(CLI::App& app, int& status) {
         "primitives the expanded tree would hold), graph bytes, peak memory and time. A PNG is "
         "written in this process; an EXR or TIFF file by the pcsg-image helper (found beside "
         "pcsg, or in PATH), which gets the pixels through a pipe once they exist.\n"
+        "Under `mpirun -np N pcsg render ...` (or srun) the render is spread over N ranks, "
+        "each using --threads cores, and rank 0 writes the same image (docs/distributed.md).\n"
         "Exit status: 0 written, 1 the scene has an error (nothing written), 2 could not run.");
     cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input)")->required();
     cmd->add_option("-o,--output", o->output,
@@ -634,7 +809,12 @@ void addRenderCommand(CLI::App& app, int& status) {
                     "Work limit of the primitive-equivalence count in graph-node visits")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    cmd->callback([o, &status] { status = runRender(*o); });
+    cmd->add_option("--tile-times", o->tileTimes,
+                    "Write every tile's cost (its thread's CPU seconds) to FILE as CSV "
+                    "(pass,x0,y0,x1,y1,seconds), "
+                    "for tools/dev/mpi_schedule_sim.py (docs/distributed.md); one process only")
+        ->group("");  // hidden: a measuring tool
+    cmd->callback([o, &status] { status = runRenderCommand(*o); });
 }
 
 }  // namespace pcsg::tools
