@@ -64,8 +64,9 @@ class MaterialReader {
 
     std::optional<double> value(uint32_t expr, uint8_t field);
     std::optional<double> number(Range& r, const Atom& item, uint8_t field);
-    std::optional<Vec3> colour(Range& r, const Atom& item, uint8_t field);
-    std::optional<Vec3> colourComponents(const Atom& model, const Atom& v, uint8_t field);
+    std::optional<FilterColour> colour(Range& r, const Atom& item, uint8_t field);
+    std::optional<FilterColour> colourComponents(const Atom& model, const Atom& v, uint8_t field);
+    void setColour(const FilterColour& c);
     const Atom* block(Range& r, const Atom& item);
     bool flag(Range& r);
     void skipValues(Range& r);
@@ -86,7 +87,8 @@ class MaterialReader {
     ExprCompiler& exprs_;
     Material& m_;
     uint32_t index_;
-    bool timed_ = false;  // the last value read reads the time
+    bool timed_ = false;      // the last value read reads the time
+    uint32_t colourTok_ = 0;  // the vector of the last colour read
 };
 
 std::string MaterialReader::describeAtom(const Atom& a) const {
@@ -126,8 +128,9 @@ std::optional<double> MaterialReader::number(Range& r, const Atom& item, uint8_t
 
 // A colour after `item` (`color` or a model word itself): `<r, g, b>` or POV-Ray's `rgb
 // <r, g, b>`, `rgbf <r, g, b, f>`, `rgbt <r, g, b, t>`, `rgbft <r, g, b, f, t>`, `rgb x`.
-// Its red, green and blue go to fields `field` to `field + 2`.
-std::optional<Vec3> MaterialReader::colour(Range& r, const Atom& item, uint8_t field) {
+// Its red, green and blue go to fields `field` to `field + 2`, and with `field` 0 (the
+// material's colour) its filter and transmit to fields 14 and 15.
+std::optional<FilterColour> MaterialReader::colour(Range& r, const Atom& item, uint8_t field) {
     const Atom* model = &item;
     if (word(item) == "color" || word(item) == "colour") {
         if (nextIs(r, AtomKind::Vector)) return colourComponents(item, ast_.atoms[r.i++], field);
@@ -151,7 +154,7 @@ std::optional<Vec3> MaterialReader::colour(Range& r, const Atom& item, uint8_t f
     if (m == "rgb" && nextIs(r, AtomKind::Number)) {
         const auto g = value(ast_.atoms[r.i++].expr, kConstant);
         if (!g) return std::nullopt;
-        return Vec3{*g, *g, *g};
+        return FilterColour{Vec3{*g, *g, *g}};
     }
     if (!nextIs(r, AtomKind::Vector)) {
         ctx_.error(model->tok, fmt::format("'{}' takes a vector", clip(m)));
@@ -162,34 +165,47 @@ std::optional<Vec3> MaterialReader::colour(Range& r, const Atom& item, uint8_t f
 }
 
 // The components of a colour vector `v` after the model word (or `color`).
-std::optional<Vec3> MaterialReader::colourComponents(const Atom& model, const Atom& v,
-                                                     uint8_t field) {
+std::optional<FilterColour> MaterialReader::colourComponents(const Atom& model, const Atom& v,
+                                                             uint8_t field) {
     const std::string_view m = word(model);
+    colourTok_ = v.tok;
     const uint32_t want = m == "rgbft" ? 5 : (m == "rgbf" || m == "rgbt") ? 4 : 3;
     if (v.count != want) {
         ctx_.error(v.tok, fmt::format("'{}' takes a vector of {} components, found {}", clip(m),
                                       want, v.count));
         return std::nullopt;
     }
-    Vec3 c;
+    // Where each component goes: red, green, blue, then filter and/or transmit.
+    const bool transmitOnly = m == "rgbt";
+    FilterColour c;
     bool ok = true;
     for (uint32_t k = 0; k < v.count; ++k) {
-        const uint8_t f =
-            (k < 3 && field != kConstant) ? static_cast<uint8_t>(field + k) : kConstant;
+        const bool isTransmit = k == 4 || (k == 3 && transmitOnly);
+        const uint8_t slot = k < 3 ? k : (isTransmit ? 15 : 14);
+        const uint8_t f = field == kConstant ? kConstant
+                          : k < 3            ? static_cast<uint8_t>(field + k)
+                          : field == 0       ? slot
+                                             : kConstant;
         const auto x = value(ast_.lists[v.first + k], f);
-        if (!x) {
+        if (!x)
             ok = false;
-        } else if (k < 3) {
-            c[static_cast<int>(k)] = *x;
-        } else if (*x != 0) {
-            ctx_.error(v.tok,
-                       "filter and transmit (transparency) are not implemented yet: "
-                       "they must be 0");
-            ok = false;
-        }
+        else if (k < 3)
+            c.rgb[static_cast<int>(k)] = *x;
+        else
+            (isTransmit ? c.transmit : c.filter) = *x;
     }
     if (!ok) return std::nullopt;
     return c;
+}
+
+// The material's plain colour (flat `color` or a pigment without a pattern).
+void MaterialReader::setColour(const FilterColour& c) {
+    m_.color = c.rgb;
+    m_.filter = c.filter;
+    m_.transmit = c.transmit;
+    if (c.filter != 0 || c.transmit != 0)
+        ctx_.error(colourTok_,
+                   "filter and transmit (transparency) are not implemented yet: they must be 0");
 }
 
 // The block `{ ... }` that follows `item`, or null (reported).
@@ -278,7 +294,7 @@ bool MaterialReader::flatItem(Range& r, const Atom& item, std::string_view n) {
             ctx_.error(item.tok, fmt::format("'{}' takes a vector '<x, y, z>'", clip(n)));
             ++r.i;
         } else if (auto c = colour(r, item, 0)) {
-            m_.color = *c;
+            setColour(*c);
         }
         return true;
     }
@@ -304,7 +320,7 @@ void MaterialReader::pigment(Range r) {
         }
         const std::string_view n = word(item);
         if (isColourWord(n)) {
-            if (auto c = colour(r, item, 0)) m_.color = *c;
+            if (auto c = colour(r, item, 0)) setColour(*c);
             continue;
         }
         reject(r, item, "pigment", kPigmentTakes);

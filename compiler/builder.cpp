@@ -40,7 +40,7 @@ std::optional<Graph> build(const Source& src, const TokenStream& tokens, const A
 
     // The order matters beyond the data each phase needs: it is the order of the
     // diagnostics, and of the parameter slots and rand() call sites in the graph.
-    ctx.g.materials.push_back(Material{"default"});
+    ctx.g.materials.push_back(Material{.name = "default"});
     readSettings(ctx, exprs);
     declareMaterials(ctx, names);
     readDirectives(ctx, names, exprs);

@@ -24,6 +24,7 @@
 
 #include "csg_op.h"
 #include "geometry.h"
+#include "texture.h"
 
 namespace pcsg {
 
@@ -244,10 +245,14 @@ struct Material {
     double reflectMetallic = 0;  // reflection { ... metallic }
     bool conserveEnergy = false;
     bool interior = false;  // an interior { } was given (the exporter writes it)
+    double filter = 0;      // 14: the plain pigment colour's filter
+    double transmit = 0;    // 15: and transmit
+    Pigment pigment{};      // its pattern (PatternKind::Plain: color, filter, transmit)
+    NormalSpec normal{};    // NormalKind::None: the surface's own normal
 
     double minReflection() const { return reflectionRange ? reflectionMin : reflection; }
 };
-inline constexpr uint8_t kMaterialFields = 14;
+inline constexpr uint8_t kMaterialFields = 16;
 
 struct Settings {
     uint64_t seed = 0;

@@ -34,7 +34,8 @@ double* targetOf(Graph& g, const TimedValue& tv) {
             Material& m = g.materials[tv.index];
             double* scalars[] = {&m.ambient,    &m.diffuse,       &m.phong,    &m.phongSize,
                                  &m.reflection, &m.brilliance,    &m.specular, &m.roughness,
-                                 &m.metallic,   &m.reflectionMin, &m.ior};
+                                 &m.metallic,   &m.reflectionMin, &m.ior,      &m.filter,
+                                 &m.transmit};
             return f < 3 ? vectorField(m.color, f) : scalars[f - 3];
         }
     }

@@ -203,8 +203,8 @@ TEST(Expander, TransformsComposeInTextOrderAndTheInnermostPaintWins) {
     // paint(1) move(1,0,0) paint(2) uscale(2) sphere
     Graph g;
     defaultScene(g);
-    g.materials.push_back(Material{"one"});
-    g.materials.push_back(Material{"two"});
+    g.materials.push_back(Material{.name = "one"});
+    g.materials.push_back(Material{.name = "two"});
     const NodeId sph = primitive(g, PrimitiveKind::Sphere);
     g.axiom = paint(g, 1,
                     transform(g, TransformOp::Move, {1, 0, 0},

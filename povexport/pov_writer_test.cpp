@@ -155,8 +155,8 @@ TEST(PovWriter, FinishItemsAndInteriors) {
 TEST(PovWriter, APaintIsOneTextureWhereThePaintStands) {
     Graph g;
     defaultScene(g);
-    g.materials.push_back(Material{"a"});
-    g.materials.push_back(Material{"b"});
+    g.materials.push_back(Material{.name = "a"});
+    g.materials.push_back(Material{.name = "b"});
     std::vector<NodeId> inner;
     for (int i = 0; i < 40; ++i)  // more than maxUnionChildren: the union is regrouped
         inner.push_back(
@@ -605,8 +605,20 @@ TEST(PovRay, ParsesAndRendersEveryPrimitiveWithoutWarnings) {
         GTEST_SKIP() << "povray is not installed (apt-get install povray)";
     // Sierpinski order 3 beside one of each primitive, with materials and several lights.
     Graph g = sierpinski(3);
-    g.materials.push_back(Material{"red", {0.8, 0.1, 0.1}, 0.1, 0.7, 0.4, 30, 0});
-    g.materials.push_back(Material{"mirror", {0.9, 0.9, 0.9}, 0.05, 0.3, 0.8, 60, 0.5});
+    g.materials.push_back(Material{.name = "red",
+                                   .color = {0.8, 0.1, 0.1},
+                                   .ambient = 0.1,
+                                   .diffuse = 0.7,
+                                   .phong = 0.4,
+                                   .phongSize = 30,
+                                   .reflection = 0});
+    g.materials.push_back(Material{.name = "mirror",
+                                   .color = {0.9, 0.9, 0.9},
+                                   .ambient = 0.05,
+                                   .diffuse = 0.3,
+                                   .phong = 0.8,
+                                   .phongSize = 60,
+                                   .reflection = 0.5});
     g.scene.lights.push_back(Light{{-10, -5, 10}, {0.4, 0.4, 0.5}});
     g.scene.background = {0.2, 0.3, 0.5};
     std::vector<NodeId> parts = {g.axiom};

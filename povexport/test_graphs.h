@@ -125,7 +125,7 @@ inline void setRule(Graph& g, NodeId selectNode, uint32_t rule, NodeId body) {
 }
 
 inline void defaultScene(Graph& g) {
-    if (g.materials.empty()) g.materials.push_back(Material{"default"});
+    if (g.materials.empty()) g.materials.push_back(Material{.name = "default"});
     if (g.scene.lights.empty()) g.scene.lights.push_back(Light{});
 }
 
