@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "pigment.h"
+
 namespace pcsg::tracer {
 
 using C = ShadingConstants;
@@ -22,10 +24,11 @@ double metallicShare(double cosAngle) {
 
 // A highlight of `intensity` in the light's colour, or with finish metallic tinted by the
 // pigment's colour.
-Vec3 highlight(double intensity, const Vec3& lightColour, const Material& m, double ndotl) {
+Vec3 highlight(double intensity, const Vec3& lightColour, const Material& m, const Vec3& pigment,
+               double ndotl) {
     if (!(m.metallic > 0)) return lightColour * intensity;
     const double k = m.metallic * metallicShare(ndotl);
-    const Vec3 tint{1 + k * (m.color.x - 1), 1 + k * (m.color.y - 1), 1 + k * (m.color.z - 1)};
+    const Vec3 tint{1 + k * (pigment.x - 1), 1 + k * (pigment.y - 1), 1 + k * (pigment.z - 1)};
     return mul(lightColour, tint) * intensity;
 }
 
@@ -33,13 +36,13 @@ Vec3 highlight(double intensity, const Vec3& lightColour, const Material& m, dou
 
 // Diffuse, phong and specular of one light seen along direction l (unit, toward the light).
 Vec3 Shader::lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
-                 const Material& m) const {
+                 const Material& m, const Vec3& pigment) const {
     Vec3 colour{0, 0, 0};
     const double cosAngle = dot(n, l);
     if (m.diffuse > 0) {
         const double c = std::fabs(cosAngle);
         const double intensity = m.brilliance != 1 ? std::pow(c, m.brilliance) : c;
-        colour += mul(lightColour, m.color) * (intensity * m.diffuse);
+        colour += mul(lightColour, pigment) * (intensity * m.diffuse);
     }
     if (m.phong > 0) {
         const Vec3 r = d - n * (2 * dot(d, n));
@@ -47,7 +50,7 @@ Vec3 Shader::lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightC
         if (c > 0) {
             const double intensity =
                 (m.phongSize < 60 || c > 0.0008) ? m.phong * std::pow(c, m.phongSize) : 0.0;
-            colour += highlight(intensity, lightColour, m, cosAngle);
+            colour += highlight(intensity, lightColour, m, pigment, cosAngle);
         }
     }
     if (m.specular > 0) {
@@ -56,14 +59,16 @@ Vec3 Shader::lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightC
         const double c = len > 0 ? dot(h, n) / len : 0.0;
         if (c > 0) {
             const double exponent = m.roughness != 0 ? 1 / m.roughness : 0.0;
-            colour += highlight(m.specular * std::pow(c, exponent), lightColour, m, cosAngle);
+            colour +=
+                highlight(m.specular * std::pow(c, exponent), lightColour, m, pigment, cosAngle);
         }
     }
     return colour;
 }
 
-Vec3 Shader::local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m) {
-    Vec3 colour = m.color * (m.ambient * C::kAmbientLight);
+Vec3 Shader::local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m,
+                   const Vec3& pigment) {
+    Vec3 colour = pigment * (m.ambient * C::kAmbientLight);
     if (!(m.diffuse != 0 || m.phong != 0 || m.specular != 0)) return colour;
     for (const Light& light : g_.scene.lights) {
         Vec3 l = light.position - p;
@@ -73,12 +78,12 @@ Vec3 Shader::local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& 
         if (dot(n, l) < C::kEpsilon) continue;  // the light is behind the surface
         ++rays_;
         if (tracer_.anyHit(p, l, C::kShadowTolerance, dist - C::kShadowTolerance)) continue;
-        colour += lit(n, d, l, light.color, m);
+        colour += lit(n, d, l, light.color, m, pigment);
     }
     return colour;
 }
 
-Reflectivity reflectivity(const Material& m, double cosIncidence) {
+Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pigment) {
     const double hi = m.reflection, lo = m.minReflection();
     Reflectivity out;
     double amount;
@@ -110,8 +115,8 @@ Reflectivity reflectivity(const Material& m, double cosIncidence) {
     out.colour = Vec3{amount, amount, amount};
     if (m.reflectMetallic != 0) {
         const double k = m.reflectMetallic * metallicShare(cosIncidence);
-        out.colour = mul(out.colour, Vec3{1 + k * (m.color.x - 1), 1 + k * (m.color.y - 1),
-                                          1 + k * (m.color.z - 1)});
+        out.colour = mul(out.colour, Vec3{1 + k * (pigment.x - 1), 1 + k * (pigment.y - 1),
+                                          1 + k * (pigment.z - 1)});
     }
     return out;
 }
@@ -133,8 +138,9 @@ Vec3 Shader::shade(const Ray& ray) {
         if (!isFinite(n)) n = -dir;  // degenerate normal (apex of a cone): face the viewer
         if (dot(n, dir) > 0) n = -n;
         const Material& m = g_.materials[hit.material < g_.materials.size() ? hit.material : 0];
-        colour += mul(local(p, n, dir, m), factor);
-        const Reflectivity r = reflectivity(m, -dot(dir, n));
+        const FilterColour pigment = pigmentColour(m, hit);
+        colour += mul(local(p, n, dir, m, pigment.rgb), factor);
+        const Reflectivity r = reflectivity(m, -dot(dir, n), pigment.rgb);
         if (r.colour.x == 0 && r.colour.y == 0 && r.colour.z == 0) break;
         weight *= r.weight;
         if (weight < C::kAdcBailout) break;

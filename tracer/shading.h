@@ -76,7 +76,7 @@ struct Reflectivity {
     Vec3 colour{0, 0, 0};
     double weight = 0;
 };
-Reflectivity reflectivity(const Material& m, double cosIncidence);
+Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pigment);
 
 // The colour seen along one ray, per thread (it owns a Tracer).
 class Shader {
@@ -92,11 +92,12 @@ class Shader {
     Tracer& tracer() { return tracer_; }
 
   private:
-    // The local colour of a surface point (ambient, diffuse, phong; no reflection).
-    Vec3 local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m);
+    // The local colour of a surface point (ambient, diffuse, phong; no reflection), whose
+    // pigment there has colour `pigment`.
+    Vec3 local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m, const Vec3& pigment);
     // Diffuse, phong and specular of one unshadowed light in direction l.
     Vec3 lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
-             const Material& m) const;
+             const Material& m, const Vec3& pigment) const;
 
     const Graph& g_;
     Tracer tracer_;

@@ -1,0 +1,13 @@
+// A pigment's colour at a surface point (docs/language.md section 10): the material's plain
+// colour, or its pattern evaluated at the hit point in the frame of the paint node that
+// applied the material (SurfaceHit::paintPoint).
+#pragma once
+
+#include "graph.h"
+#include "traversal.h"
+
+namespace pcsg::tracer {
+
+FilterColour pigmentColour(const Material& m, const SurfaceHit& hit);
+
+}  // namespace pcsg::tracer
