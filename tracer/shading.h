@@ -96,7 +96,7 @@ class Shader {
     Vec3 local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m);
     // Diffuse, phong and specular of one unshadowed light in direction l.
     Vec3 lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
-             const Material& m) const;
+             const Material& m, bool highlights = true) const;
 
     const Graph& g_;
     Tracer tracer_;
