@@ -46,17 +46,15 @@ double jitterHash(const Vec3& p, int u, int v, int axis) {
     return static_cast<double>(h >> 11) * 0x1.0p-53;
 }
 
-// The shadow of an area light at one point: POV-Ray's recursion over its grid
-// (TraceAreaLightSubsetShadowRay), each grid point traced at most once.
-class AreaShadow {
+// POV-Ray's recursion over a rectangle [u1, u2] x [v1, v2] of the grid
+// (TraceAreaLightSubsetShadowRay), each grid point sampled at most once.
+class AreaRecursion {
   public:
-    AreaShadow(const Light& light, const Vec3& p, const Vec3& colour, const Vec3& axis1,
-               const Vec3& axis2, Tracer& tracer, uint64_t& rays)
-        : light_(light), p_(p), colour_(colour), axis1_(axis1), axis2_(axis2), tracer_(tracer),
-          rays_(rays) {
+    AreaRecursion(int size1, int size2, int adaptive, const AreaSample& sample)
+        : size2_(size2), adaptive_(adaptive), sample_(sample) {
         thread_local std::vector<Vec3> grid;
         thread_local std::vector<uint8_t> done;
-        const size_t n = static_cast<size_t>(light.size1) * static_cast<size_t>(light.size2);
+        const size_t n = static_cast<size_t>(size1) * static_cast<size_t>(size2);
         grid.resize(n);
         done.assign(n, 0);
         grid_ = grid.data();
@@ -64,9 +62,9 @@ class AreaShadow {
     }
 
     Vec3 region(int u1, int v1, int u2, int v2, int level) {
-        Vec3 c[4] = {sample(u1, v1), sample(u2, v1), sample(u1, v2), sample(u2, v2)};
+        Vec3 c[4] = {at(u1, v1), at(u2, v1), at(u1, v2), at(u2, v2)};
         if ((u2 - u1 > 1 || v2 - v1 > 1) &&
-            (level < light_.adaptive || colourDistance(c[0], c[1]) > kAdaptiveThreshold ||
+            (level < adaptive_ || colourDistance(c[0], c[1]) > kAdaptiveThreshold ||
              colourDistance(c[1], c[3]) > kAdaptiveThreshold ||
              colourDistance(c[3], c[2]) > kAdaptiveThreshold ||
              colourDistance(c[2], c[0]) > kAdaptiveThreshold)) {
@@ -83,35 +81,42 @@ class AreaShadow {
     }
 
   private:
-    Vec3 sample(int u, int v) {
-        const size_t k = static_cast<size_t>(u) * static_cast<size_t>(light_.size2) +
+    Vec3 at(int u, int v) {
+        const size_t k = static_cast<size_t>(u) * static_cast<size_t>(size2_) +
                          static_cast<size_t>(v);
-        if (done_[k]) return grid_[k];
-        double ju = u, jv = v;
-        if (light_.jitter) {
-            ju += jitterHash(p_, u, v, 0) - 0.5;
-            jv += jitterHash(p_, u, v, 1) - 0.5;
+        if (!done_[k]) {
+            grid_[k] = sample_(u, v);
+            done_[k] = 1;
         }
-        Vec3 l = light_.position + areaOffset(light_, ju, jv, axis1_, axis2_) - p_;
-        const double d = length(l);
-        Vec3 c = colour_;
-        if (d > 0) {
-            ++rays_;
-            if (tracer_.anyHit(p_, l / d, kShadowTolerance, d - kShadowTolerance))
-                c = Vec3{0, 0, 0};
-        }
-        done_[k] = 1;
-        grid_[k] = c;
-        return c;
+        return grid_[k];
     }
 
-    const Light& light_;
-    Vec3 p_, colour_, axis1_, axis2_;
-    Tracer& tracer_;
-    uint64_t& rays_;
+    int size2_, adaptive_;
+    const AreaSample& sample_;
     Vec3* grid_ = nullptr;
     uint8_t* done_ = nullptr;
 };
+
+// The shadow of an area light at p: the light's colour where a grid point is visible.
+Vec3 areaShadow(const Light& light, const Vec3& p, const Vec3& colour, const Vec3& toCentre,
+                Tracer& tracer, uint64_t& rays) {
+    Vec3 axis1 = light.axis1, axis2 = light.axis2;
+    if (light.orient) orientAxes(light, toCentre, axis1, axis2);
+    const AreaSample sample = [&](int u, int v) {
+        double ju = u, jv = v;
+        if (light.jitter) {
+            ju += jitterHash(p, u, v, 0) - 0.5;
+            jv += jitterHash(p, u, v, 1) - 0.5;
+        }
+        const Vec3 l = light.position + areaOffset(light, ju, jv, axis1, axis2) - p;
+        const double d = length(l);
+        if (!(d > 0)) return colour;
+        ++rays;
+        return tracer.anyHit(p, l / d, kShadowTolerance, d - kShadowTolerance) ? Vec3{0, 0, 0}
+                                                                               : colour;
+    };
+    return areaAverage(light.size1, light.size2, light.adaptive, sample);
+}
 
 }  // namespace
 
@@ -136,6 +141,11 @@ double fadeAttenuation(const Light& light, double d) {
     if (std::fabs(light.fadeDistance) >= kEpsilon)
         return 2.0 / (1.0 + std::pow(d / light.fadeDistance, light.fadePower));
     return std::pow(d, -light.fadePower);
+}
+
+Vec3 areaAverage(int size1, int size2, int adaptive, const AreaSample& sample) {
+    AreaRecursion r(size1, size2, adaptive, sample);
+    return r.region(0, 0, size1 - 1, size2 - 1, 0);
 }
 
 Vec3 areaOffset(const Light& light, double u, double v, const Vec3& axis1, const Vec3& axis2) {
@@ -172,10 +182,7 @@ bool lightArriving(const Light& light, const Vec3& p, const Vec3& n, Tracer& tra
     if (dot(n, l) < kEpsilon) return false;  // the light is behind the surface
     if (!light.shadowless) {
         if (light.areaLight()) {
-            Vec3 axis1 = light.axis1, axis2 = light.axis2;
-            if (light.orient) orientAxes(light, l, axis1, axis2);
-            AreaShadow shadow(light, p, colour, axis1, axis2, tracer, rays);
-            colour = shadow.region(0, 0, light.size1 - 1, light.size2 - 1, 0);
+            colour = areaShadow(light, p, colour, l, tracer, rays);
         } else {
             ++rays;
             if (tracer.anyHit(p, l, kShadowTolerance, d - kShadowTolerance)) return false;

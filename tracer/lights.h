@@ -33,6 +33,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "graph.h"
 #include "traversal.h"
@@ -43,6 +44,11 @@ namespace pcsg::tracer {
 // unit direction `toLight` from the point to the light and the distance d.
 double spotAttenuation(const Light& light, const Vec3& toLight);
 double fadeAttenuation(const Light& light, double d);
+
+// POV-Ray's average over a size1 x size2 grid (see above): `sample(u, v)` is called at
+// most once per grid point, and only where the recursion reaches it.
+using AreaSample = std::function<Vec3(int u, int v)>;
+Vec3 areaAverage(int size1, int size2, int adaptive, const AreaSample& sample);
 
 // The offset from an area light's centre of its grid point (u, v) (fractional with
 // jitter), along the axes given (the light's, or turned by `orient`).
