@@ -20,8 +20,8 @@ camera {
 }
 light_source { <-4, -1, 3.5> color rgb <0.9, 0.9, 0.85>
   area_light <2, 0, 0>, <0, 2, 0>, 6, 6 adaptive 1 }
-light_source { <4, -3, 3> color rgb <0.45, 0.45, 0.55>
-  area_light <1.5, 0, 0>, <0, 0, 1.5>, 3, 3 circular orient }
+light_source { <4, -3, 3> color rgb <0.6, 0.6, 0.7>
+  area_light <3, 0, 0>, <0, 0, 3>, 3, 3 circular orient }
 background { color rgb <0.2, 0.25, 0.35> }
 
 plane { z, 0
