@@ -50,6 +50,7 @@ constexpr KeywordEntry kKeywords[] = {
     {"background", Kw::Background},
     {"material", Kw::Material},
     {"settings", Kw::Settings},
+    {"fog", Kw::Fog},
     {"paint", Kw::Paint},
     {"move", Kw::Move},
     {"translate", Kw::Translate},
@@ -442,7 +443,7 @@ class Scanner {
 bool isDirectiveKeyword(const Token& t) {
     return t.kind == Tok::Keyword &&
            (t.kw == Kw::Camera || t.kw == Kw::Light || t.kw == Kw::Background ||
-            t.kw == Kw::Material || t.kw == Kw::Settings);
+            t.kw == Kw::Material || t.kw == Kw::Settings || t.kw == Kw::Fog);
 }
 
 // Whether a statement (or an item inside braces) may end after this token.
