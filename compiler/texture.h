@@ -56,6 +56,12 @@ struct ColourMapEntry {
     FilterColour colour;
 };
 
+// One of a pattern's transformations as written (the exporter writes them back).
+struct PatternTransform {
+    enum Kind : uint8_t { Scale, Rotate, Translate } kind = Scale;
+    Vec3 v{1, 1, 1};
+};
+
 // What a pattern is and where it lives, shared by pigments and normals.
 struct PatternSpec {
     PatternKind kind = PatternKind::Plain;
@@ -71,6 +77,8 @@ struct PatternSpec {
     Affine toPattern = Affine::identity();
     Affine fromPattern = Affine::identity();  // its inverse (the transformations as written)
     bool transformed = false;
+    std::vector<PatternTransform> transforms;  // as written, in order
+    bool turbulenceWritten = false;            // turbulence, octaves, omega or lambda was written
 };
 
 struct Pigment {
