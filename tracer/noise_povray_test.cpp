@@ -1,0 +1,247 @@
+// The noise, the noise patterns, the turbulence warp and the normal perturbations against
+// POV-Ray 3.7 itself: povray renders a plane under an orthographic camera with 16-bit
+// linear output (+FP16, File_Gamma=1.0), and each pixel must equal what our functions
+// give at the point its centre sees, to within the 16-bit quantisation.
+//
+//  - Pigments: `finish { ambient 1 diffuse 0 }` and `color_map { [0 rgb 0] [1 rgb 1] }`,
+//    so a pixel is the pattern's value after frequency, phase and wave (waveValue).
+//  - Normals: a white plane, `finish { ambient 0 diffuse 1 }`, one parallel light, so a
+//    pixel is max(0, N . L) with N the perturbed normal turned towards the camera.
+//
+// The camera: pixel (px, py)'s centre sees <cx + (x0) w, cy + (y0) h, planeZ> with
+// x0 = (px + 0.5) / W - 0.5, y0 = 0.5 - (py + 0.5) / H (tracer/camera.h), w and h the
+// lengths of `right` and `up`. Skipped when povray is not installed.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "noise.h"
+#include "noise_patterns.h"
+#include "normal_patterns.h"
+
+namespace pcsg {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kW = 64, kH = 48;
+constexpr double kCx = 0.3, kCy = -0.2, kViewW = 6.0, kViewH = 4.5, kPlaneZ = 0.37;
+
+Vec3 pixelPoint(int px, int py) {
+    const double x0 = (px + 0.5) / kW - 0.5, y0 = 0.5 - (py + 0.5) / kH;
+    return Vec3{kCx + x0 * kViewW, kCy + y0 * kViewH, kPlaneZ};
+}
+
+bool havePovray() {
+    return std::system("command -v povray > /dev/null 2>&1") == 0;
+}
+
+// Reads a binary PPM (P6) with maxval 65535 (big-endian samples); returns the red channel
+// scaled to [0, 1]. POV-Ray writes comment lines in the header.
+std::vector<double> readPpm16(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string magic;
+    in >> magic;
+    auto nextNumber = [&in] {
+        in >> std::ws;
+        while (in.peek() == '#') {
+            std::string line;
+            std::getline(in, line);
+            in >> std::ws;
+        }
+        int v = 0;
+        in >> v;
+        return v;
+    };
+    const int w = nextNumber(), h = nextNumber(), maxval = nextNumber();
+    in.get();
+    if (magic != "P6" || w != kW || h != kH || maxval != 65535) return {};
+    std::vector<unsigned char> bytes(static_cast<size_t>(w) * h * 6);
+    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!in) return {};
+    std::vector<double> red(static_cast<size_t>(w) * h);
+    for (size_t i = 0; i < red.size(); ++i)
+        red[i] = (bytes[i * 6] * 256 + bytes[i * 6 + 1]) / 65535.0;
+    return red;
+}
+
+fs::path workDir() {
+    return fs::temp_directory_path() /
+           ("pcsg_noise_povray_" + std::to_string(static_cast<long>(getpid())));
+}
+
+// Renders `objects` (a plane and its texture) with the test camera; the red channel.
+std::vector<double> renderPov(const std::string& objects, const std::string& name) {
+    const fs::path dir = workDir();
+    fs::create_directories(dir);
+    const fs::path pov = dir / (name + ".pov"), ppm = dir / (name + ".ppm");
+    std::ofstream(pov) << "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                       << "camera { orthographic location <" << kCx << ", " << kCy
+                       << ", 10> direction <0, 0, -1> right <" << kViewW << ", 0, 0> up <0, "
+                       << kViewH << ", 0> }\n"
+                       << objects << "\n";
+    const std::string cmd = "povray +I" + pov.string() + " +O" + ppm.string() + " +W" +
+                            std::to_string(kW) + " +H" + std::to_string(kH) +
+                            " -A +FP16 -D File_Gamma=1.0 -GA > " + (dir / "log").string() +
+                            " 2>&1";
+    if (std::system(cmd.c_str()) != 0) return {};
+    return readPpm16(ppm);
+}
+
+// Compares POV-Ray's image with expected(point) pixel by pixel: every pixel within `tol`.
+void expectImage(const std::string& objects, const std::string& name,
+                 const std::function<double(const Vec3&)>& expected, double tol) {
+    const std::vector<double> img = renderPov(objects, name);
+    ASSERT_EQ(img.size(), static_cast<size_t>(kW * kH)) << "povray failed on " << name;
+    double worst = 0;
+    int bad = 0, worstX = 0, worstY = 0;
+    for (int py = 0; py < kH; ++py)
+        for (int px = 0; px < kW; ++px) {
+            const double want = std::clamp(expected(pixelPoint(px, py)), 0.0, 1.0);
+            const double d = std::fabs(img[py * kW + px] - want);
+            if (d > tol) ++bad;
+            if (d > worst) {
+                worst = d;
+                worstX = px;
+                worstY = py;
+            }
+        }
+    EXPECT_EQ(bad, 0) << name << ": " << bad << " pixels off by more than " << tol * 65535
+                      << "/65535; worst " << worst * 65535 << "/65535 at (" << worstX << ", "
+                      << worstY << ")";
+    ::testing::Test::RecordProperty(name + "_worst_in_65535ths", std::to_string(worst * 65535));
+}
+
+// POV-Ray rounds to the nearest of 65536 levels (from single-precision colours): an exact
+// value is within half a level, plus a little.
+constexpr double kTol = 0.55 / 65535;
+
+std::string greyPigment(const std::string& pattern) {
+    return "plane { z, " + std::to_string(kPlaneZ) + " pigment { " + pattern +
+           " color_map { [0 rgb 0] [1 rgb 1] } } finish { ambient 1 diffuse 0 } }";
+}
+
+PatternSpec spec(PatternKind kind, const Affine& fromPattern = Affine::identity()) {
+    PatternSpec s;
+    s.kind = kind;
+    s.fromPattern = fromPattern;
+    s.toPattern = fromPattern.inverse();
+    return s;
+}
+
+// The value a pigment of this spec shows at a point of the plane.
+double pigmentValue(const PatternSpec& s, const Vec3& p) {
+    const double raw = noisePatternValue(s, s.toPattern.point(p));
+    return waveValue(raw, s.frequency, s.phase, patternDefaults(s.kind).wave);
+}
+
+class NoisePovray : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        if (!havePovray()) GTEST_SKIP() << "POV-Ray is not installed (apt-get install povray)";
+    }
+    static void TearDownTestSuite() {
+        std::error_code ec;
+        fs::remove_all(workDir(), ec);
+    }
+};
+
+TEST_F(NoisePovray, BozoIsPovRaysNoise) {
+    expectImage(greyPigment("bozo"), "bozo", [](const Vec3& p) { return noise(p); }, kTol);
+}
+
+TEST_F(NoisePovray, BozoScaledAndMoved) {
+    const Affine m = Affine::translate({0.4, -1.3, 2.1}) * Affine::scale({0.3, 0.5, 0.7});
+    const PatternSpec s = spec(PatternKind::Bozo, m);
+    expectImage(greyPigment("bozo scale <0.3, 0.5, 0.7> translate <0.4, -1.3, 2.1>"),
+                "bozo_moved", [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+TEST_F(NoisePovray, Granite) {
+    const PatternSpec s = spec(PatternKind::Granite, Affine::scale({2, 2, 2}));
+    expectImage(greyPigment("granite scale 2"), "granite",
+                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+TEST_F(NoisePovray, WoodWithTurbulence) {
+    PatternSpec s = spec(PatternKind::Wood, Affine::scale({0.5, 0.5, 0.5}));
+    s.turbulence.amount = {0.3, 0.3, 0.3};
+    expectImage(greyPigment("wood turbulence 0.3 scale 0.5"), "wood",
+                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+TEST_F(NoisePovray, MarbleWithTurbulence) {
+    PatternSpec s = spec(PatternKind::Marble);
+    s.turbulence.amount = {0.8, 0.8, 0.8};
+    expectImage(greyPigment("marble turbulence 0.8"), "marble",
+                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+TEST_F(NoisePovray, AgateDefault) {
+    const PatternSpec s = spec(PatternKind::Agate, Affine::scale({0.7, 0.7, 0.7}));
+    expectImage(greyPigment("agate scale 0.7"), "agate",
+                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+TEST_F(NoisePovray, AgateWithTurbulenceAndAgateTurb) {
+    PatternSpec s = spec(PatternKind::Agate);
+    s.turbulence.amount = {0.4, 0.4, 0.4};
+    s.agateTurb = 0.5;
+    expectImage(greyPigment("agate agate_turb 0.5 turbulence 0.4"), "agate_turb",
+                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+TEST_F(NoisePovray, WrinklesWithTurbulence) {
+    PatternSpec s = spec(PatternKind::Wrinkles, Affine::scale({0.6, 0.6, 0.6}));
+    s.turbulence.amount = {0.2, 0.2, 0.2};
+    expectImage(greyPigment("wrinkles turbulence 0.2 scale 0.6"), "wrinkles",
+                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+TEST_F(NoisePovray, Dents) {
+    const PatternSpec s = spec(PatternKind::Dents, Affine::scale({0.4, 0.4, 0.4}));
+    expectImage(greyPigment("dents scale 0.4"), "dents",
+                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+}
+
+// The turbulence warp with every modifier, applied after the pattern's transformations
+// even when written before them.
+TEST_F(NoisePovray, TurbulenceWarpWithModifiers) {
+    PatternSpec s = spec(PatternKind::Bozo, Affine::scale({0.8, 0.8, 0.8}));
+    s.turbulence.amount = {0.5, 0.3, 0.7};
+    s.turbulence.octaves = 4;
+    s.turbulence.omega = 0.6;
+    s.turbulence.lambda = 2.5;
+    const auto value = [&](const Vec3& p) { return pigmentValue(s, p); };
+    expectImage(greyPigment("bozo turbulence <0.5, 0.3, 0.7> octaves 4 omega 0.6 lambda 2.5 "
+                            "scale 0.8"),
+                "turb_after", value, kTol);
+    expectImage(greyPigment("bozo scale 0.8 turbulence <0.5, 0.3, 0.7> octaves 4 omega 0.6 "
+                            "lambda 2.5"),
+                "turb_before", value, kTol);
+}
+
+// turbulenceWarp on a pattern that is not noise-based: gradient x (raw value x, folded).
+TEST_F(NoisePovray, TurbulenceWarpOnGradient) {
+    Turbulence t;
+    t.amount = {0.6, 0.6, 0.6};
+    const auto value = [&](const Vec3& p) {
+        const Vec3 q = turbulenceWarp(t, Affine::scale({2, 2, 2}).point(p));
+        double g = q.x;
+        if (g > 1.0) g = std::fmod(g, 1.0);
+        return waveValue(g, 1.0, 0.0, WaveForm::Ramp);
+    };
+    expectImage(greyPigment("gradient x turbulence 0.6 scale 0.5"), "gradient_turb", value,
+                kTol);
+}
+
+}  // namespace
+}  // namespace pcsg
