@@ -243,5 +243,98 @@ TEST_F(NoisePovray, TurbulenceWarpOnGradient) {
                 kTol);
 }
 
+// Normals: a white plane lit by one parallel light from <1, 2, 3>, seen from above.
+const Vec3 kToLight = Vec3{1, 2, 3} / std::sqrt(14.0);
+
+std::string litPlane(const std::string& normal, bool facingDown = false) {
+    const std::string z = std::to_string(kPlaneZ);
+    return std::string("plane { ") + (facingDown ? "-z, -" : "z, ") + z +
+           " pigment { rgb 1 } normal { " + normal +
+           " } finish { ambient 0 diffuse 1 } }\n"
+           "light_source { <1000, 2000, 3000> color rgb 1 parallel point_at <0, 0, 0> }";
+}
+
+// The diffuse light at a point, in POV-Ray's order (normal_patterns.h): the plane's normal
+// turned towards the camera (looking down -z), then perturbed through the pattern's maps;
+// the result is used as it is.
+double litValue(const NormalSpec& n, const Vec3& p, const Vec3& planeNormal) {
+    const Vec3 raw = planeNormal.z < 0 ? -planeNormal : planeNormal;
+    const Vec3 r = perturbNormalThrough(n, n.pattern.toPattern, n.pattern.fromPattern,
+                                        n.pattern.transformed, p, raw);
+    return std::max(0.0, dot(r, kToLight));
+}
+
+NormalSpec normalSpec(NormalKind kind, double amount, const Affine& fromPattern) {
+    NormalSpec n;
+    n.kind = kind;
+    n.amount = amount;
+    n.pattern = spec(PatternKind::Plain, fromPattern);
+    n.pattern.transformed = !(fromPattern == Affine::identity());
+    return n;
+}
+
+Affine rotateZ(double degrees) {
+    const double a = degrees * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
+    Affine r;
+    r.l[0][0] = c;
+    r.l[0][1] = -s;
+    r.l[1][0] = s;
+    r.l[1][1] = c;
+    return r;
+}
+
+TEST_F(NoisePovray, BumpsNormal) {
+    const NormalSpec n = normalSpec(NormalKind::Bumps, 0.5, Affine::scale({0.2, 0.2, 0.2}));
+    expectImage(litPlane("bumps 0.5 scale 0.2"), "bumps",
+                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+}
+
+// POV-Ray turns the plane's normal (-z here) towards the camera before perturbing it:
+// perturbing -z and turning the result would mirror the bumps (every pixel differs).
+TEST_F(NoisePovray, BumpsOnAPlaneFacingAway) {
+    const NormalSpec n = normalSpec(NormalKind::Bumps, 0.5, Affine::scale({0.2, 0.2, 0.2}));
+    expectImage(litPlane("bumps 0.5 scale 0.2", true), "bumps_down",
+                [&](const Vec3& p) { return litValue(n, p, {0, 0, -1}); }, kTol);
+}
+
+TEST_F(NoisePovray, DentsNormal) {
+    const NormalSpec n = normalSpec(NormalKind::Dents, 0.8, Affine::scale({0.3, 0.3, 0.3}));
+    expectImage(litPlane("dents 0.8 scale 0.3"), "dents_normal",
+                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+}
+
+TEST_F(NoisePovray, WrinklesNormal) {
+    const NormalSpec n = normalSpec(NormalKind::Wrinkles, 0.6, Affine::scale({0.4, 0.4, 0.4}));
+    expectImage(litPlane("wrinkles 0.6 scale 0.4"), "wrinkles_normal",
+                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+}
+
+TEST_F(NoisePovray, RipplesNormalWithTurbulence) {
+    NormalSpec n = normalSpec(NormalKind::Ripples, 0.5, Affine::scale({0.8, 0.8, 0.8}));
+    n.pattern.frequency = 3;
+    n.pattern.turbulence.amount = {0.2, 0.2, 0.2};
+    expectImage(litPlane("ripples 0.5 frequency 3 turbulence 0.2 scale 0.8"), "ripples",
+                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+}
+
+TEST_F(NoisePovray, WavesNormalWithPhase) {
+    NormalSpec n = normalSpec(NormalKind::Waves, 0.6, Affine::identity());
+    n.pattern.frequency = 2;
+    n.pattern.phase = 0.25;
+    expectImage(litPlane("waves 0.6 frequency 2 phase 0.25"), "waves",
+                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+}
+
+// A non-uniform scale and a rotation: the normal goes into pattern space by M^T and back
+// by M^-T, and the turbulence comes after both.
+TEST_F(NoisePovray, BumpsThroughNonUniformRotatedPattern) {
+    NormalSpec n =
+        normalSpec(NormalKind::Bumps, 0.4, rotateZ(30) * Affine::scale({0.3, 0.6, 1.0}));
+    n.pattern.turbulence.amount = {0.5, 0.5, 0.5};
+    expectImage(litPlane("bumps 0.4 turbulence 0.5 scale <0.3, 0.6, 1> rotate 30*z"),
+                "bumps_rotated", [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); },
+                kTol);
+}
+
 }  // namespace
 }  // namespace pcsg

@@ -4,10 +4,12 @@
 // waves POV-Ray's wave sources (noise.h noiseWaves()).
 //
 // What the shading code does with them, in POV-Ray's order (trace.cpp
-// ComputeLightedTexture, normal.cpp Perturb_Normal):
+// ComputeTextureColour and ComputeLightedTexture, normal.cpp Perturb_Normal); checked
+// against povray renders in tracer/noise_povray_test.cpp:
 //
-//   1. Start from the surface's geometric normal as the object gives it, NOT yet turned
-//      towards the ray (POV-Ray perturbs its raw normal and flips the result afterwards).
+//   1. Start from the surface's geometric normal already turned towards the ray (POV-Ray
+//      flips its raw normal, "if the surface normal points away, flip its direction",
+//      BEFORE texturing; a plane seen from behind is perturbed about the flipped normal).
 //   2. Warp_Normal: n = normalize(n); with a transformed pattern,
 //      n = normalize(M^T n), M = the map from pattern space to the frame the point is in
 //      (PatternSpec::fromPattern composed with the paint frame), M^T its linear part
@@ -16,7 +18,10 @@
 //      applied by the caller: perturbNormal does it (POV-Ray's classic warp, the last one).
 //   4. r = perturbNormal(spec, p, n) (normalised).
 //   5. UnWarp_Normal: with a transformed pattern, r = normalize((M^-1)^T r).
-//   6. Turn r towards the ray (if r . D > 0, r = -r), as for any normal.
+//   6. Use r for lighting and reflection as it is: POV-Ray does not flip the perturbed
+//      normal again (it may face away from the ray at grazing angles; diffuse light then
+//      skips it as for any N . L < 0). Refraction and the raw normal's other uses keep the
+//      unperturbed normal of step 1 (trace.cpp passes both).
 //
 // perturbNormalThrough does 2 to 5 for a given pair of maps.
 #pragma once
