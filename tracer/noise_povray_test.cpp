@@ -212,6 +212,34 @@ TEST_F(NoisePovray, Dents) {
                 [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
 }
 
+// A magnifying glass: frequency 4096 multiplies any difference of the raw values by 4096
+// before the 16-bit output, so agreement here means agreement to about 1e-9. Pixels whose
+// folded value is within 0.002 of the fold (where a difference in the last bit may land
+// on the other side of it) are not compared.
+TEST_F(NoisePovray, BozoAndTurbulenceToNineDigits) {
+    for (const char* name : {"bozo_x4096", "turb_x4096"}) {
+        PatternSpec s = spec(PatternKind::Bozo, Affine::scale({0.7, 0.7, 0.7}));
+        s.frequency = 4096;
+        std::string text = "bozo frequency 4096 scale 0.7";
+        if (std::string(name) == "turb_x4096") {
+            s.turbulence.amount = {0.4, 0.4, 0.4};
+            text = "bozo frequency 4096 turbulence 0.4 scale 0.7";
+        }
+        const std::vector<double> img = renderPov(greyPigment(text), name);
+        ASSERT_EQ(img.size(), static_cast<size_t>(kW * kH));
+        int compared = 0, bad = 0;
+        for (int py = 0; py < kH; ++py)
+            for (int px = 0; px < kW; ++px) {
+                const double v = pigmentValue(s, pixelPoint(px, py));
+                if (v < 0.002 || v > 0.998) continue;
+                ++compared;
+                if (std::fabs(img[py * kW + px] - v) > kTol) ++bad;
+            }
+        EXPECT_GT(compared, kW * kH * 9 / 10) << name;
+        EXPECT_EQ(bad, 0) << name << ": " << bad << " of " << compared << " pixels differ";
+    }
+}
+
 // The turbulence warp with every modifier, applied after the pattern's transformations
 // even when written before them.
 TEST_F(NoisePovray, TurbulenceWarpWithModifiers) {
