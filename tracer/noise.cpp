@@ -85,7 +85,7 @@ int truncateToInt(double v) {
 }
 
 struct LatticeAxis {
-    int index;  // 0..4095
+    int index;    // 0..4095
     double low;   // offset from the lower lattice plane
     double high;  // offset from the upper one (low - 1)
     double s;     // smoothstep weight of the upper plane

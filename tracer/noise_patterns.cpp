@@ -93,21 +93,6 @@ Vec3 turbulenceWarp(const Turbulence& t, const Vec3& p) {
     return Vec3{p.x + d.x * t.amount.x, p.y + d.y * t.amount.y, p.z + d.z * t.amount.z};
 }
 
-bool isNoisePattern(PatternKind kind) {
-    switch (kind) {
-        case PatternKind::Bozo:
-        case PatternKind::Granite:
-        case PatternKind::Wood:
-        case PatternKind::Marble:
-        case PatternKind::Agate:
-        case PatternKind::Wrinkles:
-        case PatternKind::Dents:
-            return true;
-        default:
-            return false;
-    }
-}
-
 double noisePatternValue(const PatternSpec& spec, const Vec3& p) {
     const Turbulence& t = spec.turbulence;
     switch (spec.kind) {

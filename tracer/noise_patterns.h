@@ -8,7 +8,7 @@
 //     Vec3 p = spec.toPattern.point(pointInPaintFrame);      // the transformations
 //     const PatternDefaults d = patternDefaults(spec.kind);
 //     double raw;
-//     if (isNoisePattern(spec.kind)) {
+//     if (d.turbulenceInside) {                              // the 7 noise patterns
 //         raw = noisePatternValue(spec, p);                  // applies the turbulence
 //     } else {
 //         p = turbulenceWarp(spec.turbulence, p);            // POV-Ray's classic warp
@@ -32,9 +32,6 @@
 #include "texture.h"
 
 namespace pcsg {
-
-// True for bozo, granite, wood, marble, agate, wrinkles and dents.
-bool isNoisePattern(PatternKind kind);
 
 // The raw value of a noise-based pattern at a pattern-space point (after the pattern's
 // transformations, BEFORE turbulence): POV-Ray's pattern function for that kind, before

@@ -90,8 +90,7 @@ std::vector<double> renderPov(const std::string& objects, const std::string& nam
                        << objects << "\n";
     const std::string cmd = "povray +I" + pov.string() + " +O" + ppm.string() + " +W" +
                             std::to_string(kW) + " +H" + std::to_string(kH) +
-                            " -A +FP16 -D File_Gamma=1.0 -GA > " + (dir / "log").string() +
-                            " 2>&1";
+                            " -A +FP16 -D File_Gamma=1.0 -GA > " + (dir / "log").string() + " 2>&1";
     if (std::system(cmd.c_str()) != 0) return {};
     return readPpm16(ppm);
 }
@@ -155,61 +154,70 @@ class NoisePovray : public ::testing::Test {
 };
 
 TEST_F(NoisePovray, BozoIsPovRaysNoise) {
-    expectImage(greyPigment("bozo"), "bozo", [](const Vec3& p) { return noise(p); }, kTol);
+    expectImage(
+        greyPigment("bozo"), "bozo", [](const Vec3& p) { return noise(p); }, kTol);
 }
 
 TEST_F(NoisePovray, BozoScaledAndMoved) {
     const Affine m = Affine::translate({0.4, -1.3, 2.1}) * Affine::scale({0.3, 0.5, 0.7});
     const PatternSpec s = spec(PatternKind::Bozo, m);
-    expectImage(greyPigment("bozo scale <0.3, 0.5, 0.7> translate <0.4, -1.3, 2.1>"),
-                "bozo_moved", [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("bozo scale <0.3, 0.5, 0.7> translate <0.4, -1.3, 2.1>"), "bozo_moved",
+        [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
 }
 
 TEST_F(NoisePovray, Granite) {
     const PatternSpec s = spec(PatternKind::Granite, Affine::scale({2, 2, 2}));
-    expectImage(greyPigment("granite scale 2"), "granite",
-                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("granite scale 2"), "granite",
+        [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
 }
 
 TEST_F(NoisePovray, WoodWithTurbulence) {
     PatternSpec s = spec(PatternKind::Wood, Affine::scale({0.5, 0.5, 0.5}));
     s.turbulence.amount = {0.3, 0.3, 0.3};
-    expectImage(greyPigment("wood turbulence 0.3 scale 0.5"), "wood",
-                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("wood turbulence 0.3 scale 0.5"), "wood",
+        [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
 }
 
 TEST_F(NoisePovray, MarbleWithTurbulence) {
     PatternSpec s = spec(PatternKind::Marble);
     s.turbulence.amount = {0.8, 0.8, 0.8};
-    expectImage(greyPigment("marble turbulence 0.8"), "marble",
-                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("marble turbulence 0.8"), "marble",
+        [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
 }
 
 TEST_F(NoisePovray, AgateDefault) {
     const PatternSpec s = spec(PatternKind::Agate, Affine::scale({0.7, 0.7, 0.7}));
-    expectImage(greyPigment("agate scale 0.7"), "agate",
-                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("agate scale 0.7"), "agate", [&](const Vec3& p) { return pigmentValue(s, p); },
+        kTol);
 }
 
 TEST_F(NoisePovray, AgateWithTurbulenceAndAgateTurb) {
     PatternSpec s = spec(PatternKind::Agate);
     s.turbulence.amount = {0.4, 0.4, 0.4};
     s.agateTurb = 0.5;
-    expectImage(greyPigment("agate agate_turb 0.5 turbulence 0.4"), "agate_turb",
-                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("agate agate_turb 0.5 turbulence 0.4"), "agate_turb",
+        [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
 }
 
 TEST_F(NoisePovray, WrinklesWithTurbulence) {
     PatternSpec s = spec(PatternKind::Wrinkles, Affine::scale({0.6, 0.6, 0.6}));
     s.turbulence.amount = {0.2, 0.2, 0.2};
-    expectImage(greyPigment("wrinkles turbulence 0.2 scale 0.6"), "wrinkles",
-                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("wrinkles turbulence 0.2 scale 0.6"), "wrinkles",
+        [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
 }
 
 TEST_F(NoisePovray, Dents) {
     const PatternSpec s = spec(PatternKind::Dents, Affine::scale({0.4, 0.4, 0.4}));
-    expectImage(greyPigment("dents scale 0.4"), "dents",
-                [&](const Vec3& p) { return pigmentValue(s, p); }, kTol);
+    expectImage(
+        greyPigment("dents scale 0.4"), "dents", [&](const Vec3& p) { return pigmentValue(s, p); },
+        kTol);
 }
 
 // A magnifying glass: frequency 4096 multiplies any difference of the raw values by 4096
@@ -267,8 +275,7 @@ TEST_F(NoisePovray, TurbulenceWarpOnGradient) {
         if (g > 1.0) g = std::fmod(g, 1.0);
         return waveValue(g, 1.0, 0.0, WaveForm::Ramp);
     };
-    expectImage(greyPigment("gradient x turbulence 0.6 scale 0.5"), "gradient_turb", value,
-                kTol);
+    expectImage(greyPigment("gradient x turbulence 0.6 scale 0.5"), "gradient_turb", value, kTol);
 }
 
 // Normals: a white plane lit by one parallel light from <1, 2, 3>, seen from above.
@@ -313,55 +320,81 @@ Affine rotateZ(double degrees) {
 
 TEST_F(NoisePovray, BumpsNormal) {
     const NormalSpec n = normalSpec(NormalKind::Bumps, 0.5, Affine::scale({0.2, 0.2, 0.2}));
-    expectImage(litPlane("bumps 0.5 scale 0.2"), "bumps",
-                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+    expectImage(
+        litPlane("bumps 0.5 scale 0.2"), "bumps",
+        [&](const Vec3& p) {
+            return litValue(n, p, {0, 0, 1});
+        },
+        kTol);
 }
 
 // POV-Ray turns the plane's normal (-z here) towards the camera before perturbing it:
 // perturbing -z and turning the result would mirror the bumps (every pixel differs).
 TEST_F(NoisePovray, BumpsOnAPlaneFacingAway) {
     const NormalSpec n = normalSpec(NormalKind::Bumps, 0.5, Affine::scale({0.2, 0.2, 0.2}));
-    expectImage(litPlane("bumps 0.5 scale 0.2", true), "bumps_down",
-                [&](const Vec3& p) { return litValue(n, p, {0, 0, -1}); }, kTol);
+    expectImage(
+        litPlane("bumps 0.5 scale 0.2", true), "bumps_down",
+        [&](const Vec3& p) {
+            return litValue(n, p, {0, 0, -1});
+        },
+        kTol);
 }
 
 TEST_F(NoisePovray, DentsNormal) {
     const NormalSpec n = normalSpec(NormalKind::Dents, 0.8, Affine::scale({0.3, 0.3, 0.3}));
-    expectImage(litPlane("dents 0.8 scale 0.3"), "dents_normal",
-                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+    expectImage(
+        litPlane("dents 0.8 scale 0.3"), "dents_normal",
+        [&](const Vec3& p) {
+            return litValue(n, p, {0, 0, 1});
+        },
+        kTol);
 }
 
 TEST_F(NoisePovray, WrinklesNormal) {
     const NormalSpec n = normalSpec(NormalKind::Wrinkles, 0.6, Affine::scale({0.4, 0.4, 0.4}));
-    expectImage(litPlane("wrinkles 0.6 scale 0.4"), "wrinkles_normal",
-                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+    expectImage(
+        litPlane("wrinkles 0.6 scale 0.4"), "wrinkles_normal",
+        [&](const Vec3& p) {
+            return litValue(n, p, {0, 0, 1});
+        },
+        kTol);
 }
 
 TEST_F(NoisePovray, RipplesNormalWithTurbulence) {
     NormalSpec n = normalSpec(NormalKind::Ripples, 0.5, Affine::scale({0.8, 0.8, 0.8}));
     n.pattern.frequency = 3;
     n.pattern.turbulence.amount = {0.2, 0.2, 0.2};
-    expectImage(litPlane("ripples 0.5 frequency 3 turbulence 0.2 scale 0.8"), "ripples",
-                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+    expectImage(
+        litPlane("ripples 0.5 frequency 3 turbulence 0.2 scale 0.8"), "ripples",
+        [&](const Vec3& p) {
+            return litValue(n, p, {0, 0, 1});
+        },
+        kTol);
 }
 
 TEST_F(NoisePovray, WavesNormalWithPhase) {
     NormalSpec n = normalSpec(NormalKind::Waves, 0.6, Affine::identity());
     n.pattern.frequency = 2;
     n.pattern.phase = 0.25;
-    expectImage(litPlane("waves 0.6 frequency 2 phase 0.25"), "waves",
-                [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); }, kTol);
+    expectImage(
+        litPlane("waves 0.6 frequency 2 phase 0.25"), "waves",
+        [&](const Vec3& p) {
+            return litValue(n, p, {0, 0, 1});
+        },
+        kTol);
 }
 
 // A non-uniform scale and a rotation: the normal goes into pattern space by M^T and back
 // by M^-T, and the turbulence comes after both.
 TEST_F(NoisePovray, BumpsThroughNonUniformRotatedPattern) {
-    NormalSpec n =
-        normalSpec(NormalKind::Bumps, 0.4, rotateZ(30) * Affine::scale({0.3, 0.6, 1.0}));
+    NormalSpec n = normalSpec(NormalKind::Bumps, 0.4, rotateZ(30) * Affine::scale({0.3, 0.6, 1.0}));
     n.pattern.turbulence.amount = {0.5, 0.5, 0.5};
-    expectImage(litPlane("bumps 0.4 turbulence 0.5 scale <0.3, 0.6, 1> rotate 30*z"),
-                "bumps_rotated", [&](const Vec3& p) { return litValue(n, p, {0, 0, 1}); },
-                kTol);
+    expectImage(
+        litPlane("bumps 0.4 turbulence 0.5 scale <0.3, 0.6, 1> rotate 30*z"), "bumps_rotated",
+        [&](const Vec3& p) {
+            return litValue(n, p, {0, 0, 1});
+        },
+        kTol);
 }
 
 }  // namespace

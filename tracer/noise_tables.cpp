@@ -4,6 +4,7 @@ namespace pcsg::noise_detail {
 
 // Copied value for value from POV-Ray 3.7's RTable (every other entry: POV-Ray fills the
 // entries between at start-up). Six values a row, as POV-Ray lists them.
+// clang-format off
 const std::array<double, 267> kRTableValues = {
     -1,         0.604974,    -0.937102,  0.414115,   0.576226,   -0.0161593,
     0.432334,   0.103685,    0.590539,   0.0286412,  0.46981,    -0.84622,
@@ -51,5 +52,6 @@ const std::array<double, 267> kRTableValues = {
     0.659449,   -0.027512,   0.821897,   -0.226215,  0.0181735,  0.500481,
     -0.420127,  -0.427878,   0.566186,
 };
+// clang-format on
 
 }  // namespace pcsg::noise_detail

@@ -2,6 +2,8 @@
 // whatever POV-Ray's exact values are (those are checked against povray itself in
 // noise_povray_test.cpp): ranges, determinism across threads, POV-Ray's 4096-cell period,
 // how turbulence is built from the noise, the defaults table and the wave forms.
+#include "noise.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include <thread>
 #include <vector>
 
-#include "noise.h"
 #include "noise_patterns.h"
 #include "normal_patterns.h"
 
@@ -93,8 +94,7 @@ TEST(Turbulence, IsTheOctaveSumOfTheNoise) {
     t.octaves = 3;
     t.omega = 0.4;
     t.lambda = 3.0;
-    const double expected = std::clamp(2 * n - 0.5, 0.0, 1.0) +
-                            0.4 * (2 * noise(p * 3.0) - 0.5) +
+    const double expected = std::clamp(2 * n - 0.5, 0.0, 1.0) + 0.4 * (2 * noise(p * 3.0) - 0.5) +
                             0.16 * (2 * noise(p * 9.0) - 0.5);
     EXPECT_NEAR(turbulence(p, t), expected, 1e-15);
     const Vec3 d = dnoise(p) + dnoise(p * 3.0) * 0.4 + dnoise(p * 9.0) * 0.16;
@@ -167,7 +167,7 @@ TEST(WaveForms, PovRaysFoldAndShapes) {
     EXPECT_NEAR(waveValue(0.3, 2.0, 0.1, WaveForm::Ramp), 0.7, 1e-12);
     EXPECT_NEAR(waveValue(0.8, 2.0, 0.0, WaveForm::Ramp), 0.6 - 0.00001, 1e-12);
     EXPECT_NEAR(waveValue(-0.3, 1.0, 0.0, WaveForm::Ramp), 0.7, 1e-12);  // negative wraps
-    EXPECT_EQ(waveValue(2.5, 0.0, 0.3, WaveForm::Ramp), 2.5);  // frequency 0: untouched
+    EXPECT_EQ(waveValue(2.5, 0.0, 0.3, WaveForm::Ramp), 2.5);            // frequency 0: untouched
     EXPECT_NEAR(waveValue(0.25, 1.0, 0.0, WaveForm::Triangle), 0.5, 1e-12);
     EXPECT_NEAR(waveValue(0.75, 1.0, 0.0, WaveForm::Triangle), 0.5, 1e-12);
     EXPECT_NEAR(waveValue(0.25, 1.0, 0.0, WaveForm::Sine), 1.0, 1e-12);
@@ -191,8 +191,7 @@ TEST(PatternDefaultsTable, PovRaysDefaults) {
     EXPECT_FALSE(patternDefaults(PatternKind::Gradient).turbulenceInside);
     EXPECT_EQ(patternDefaults(PatternKind::Bozo).colourMap.size(), 6u);
     EXPECT_EQ(patternDefaults(PatternKind::Bozo, true).colourMap.size(), 2u);  // spotted
-    EXPECT_EQ(patternDefaults(PatternKind::Granite).colourMap.back().colour.rgb,
-              (Vec3{1, 1, 1}));
+    EXPECT_EQ(patternDefaults(PatternKind::Granite).colourMap.back().colour.rgb, (Vec3{1, 1, 1}));
     EXPECT_EQ(patternDefaults(PatternKind::Checker).colourMap[0].colour.rgb, (Vec3{0, 0, 1}));
     EXPECT_EQ(patternDefaults(PatternKind::Hexagon).colourMap.size(), 3u);
     EXPECT_EQ(patternDefaults(PatternKind::Agate).colourMap.size(), 6u);

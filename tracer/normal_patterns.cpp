@@ -36,8 +36,8 @@ Vec3 waveSum(const NormalSpec& spec, const Vec3& q, Vec3 n, bool waves) {
         if (length == 0.0) length = 1.0;
         double scalar;
         if (waves) {
-            const double index = length * spec.pattern.frequency * w.frequency[i] +
-                                 spec.pattern.phase;
+            const double index =
+                length * spec.pattern.frequency * w.frequency[i] + spec.pattern.phase;
             scalar = cycloidal(index) * spec.amount / w.frequency[i];
         } else {
             const double index = length * spec.pattern.frequency + spec.pattern.phase;

@@ -40,12 +40,11 @@ std::vector<ColourMapEntry> defaultColourMap(PatternKind kind, bool spotted) {
         case PatternKind::Wood:
             return {entry(0.6, 0.666, 0.312, 0.2), entry(0.6, 0.4, 0.1333, 0.066)};
         case PatternKind::Marble:
-            return {entry(0.0, 0.9, 0.8, 0.8), entry(0.9, 0.9, 0.08, 0.08),
-                    entry(0.9, 0, 0, 0)};
+            return {entry(0.0, 0.9, 0.8, 0.8), entry(0.9, 0.9, 0.08, 0.08), entry(0.9, 0, 0, 0)};
         case PatternKind::Agate:
-            return {entry(0.0, 1, 1, 1),        entry(0.5, 0.95, 0.75, 0.5),
-                    entry(0.5, 0.9, 0.7, 0.5),  entry(0.6, 0.9, 0.7, 0.4),
-                    entry(0.6, 1.0, 0.7, 0.4),  entry(1.0, 0.6, 0.3, 0.0)};
+            return {entry(0.0, 1, 1, 1),       entry(0.5, 0.95, 0.75, 0.5),
+                    entry(0.5, 0.9, 0.7, 0.5), entry(0.6, 0.9, 0.7, 0.4),
+                    entry(0.6, 1.0, 0.7, 0.4), entry(1.0, 0.6, 0.3, 0.0)};
         case PatternKind::Radial:
             return {entry(0.0, 0, 1, 1), entry(0.333, 1, 1, 0), entry(0.666, 1, 0, 1),
                     entry(1.0, 0, 1, 1)};
@@ -63,6 +62,22 @@ std::vector<ColourMapEntry> defaultColourMap(PatternKind kind, bool spotted) {
     return {entry(0.0, 0, 0, 0), entry(1.0, 1, 1, 1)};
 }
 
+// The seven noise patterns, which noisePatternValue evaluates with their turbulence.
+bool isNoiseKind(PatternKind kind) {
+    switch (kind) {
+        case PatternKind::Bozo:
+        case PatternKind::Granite:
+        case PatternKind::Wood:
+        case PatternKind::Marble:
+        case PatternKind::Agate:
+        case PatternKind::Wrinkles:
+        case PatternKind::Dents:
+            return true;
+        default:
+            return false;
+    }
+}
+
 }  // namespace
 
 PatternDefaults patternDefaults(PatternKind kind, bool spotted) {
@@ -72,7 +87,7 @@ PatternDefaults patternDefaults(PatternKind kind, bool spotted) {
                                                                         : WaveForm::Ramp;
     d.continuous = !(kind == PatternKind::Checker || kind == PatternKind::Brick ||
                      kind == PatternKind::Hexagon || kind == PatternKind::Plain);
-    d.turbulenceInside = isNoisePattern(kind);
+    d.turbulenceInside = isNoiseKind(kind);
     return d;
 }
 
