@@ -143,6 +143,10 @@ const double* tableAt(const NoiseTables& t, int hash2d, int iz) {
 
 }  // namespace
 
+std::span<const uint16_t, 8192> noise_detail::hashTable() {
+    return std::span<const uint16_t, 8192>(kTables.hash);
+}
+
 double noise(const Vec3& p) {
     const NoiseTables& t = tables();
     const Cell c = cellOf(p, t);

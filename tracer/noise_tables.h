@@ -3,6 +3,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <span>
 
 namespace pcsg::noise_detail {
 
@@ -61,5 +63,9 @@ inline constexpr std::array<double, 267> kRTableValues = {
     -0.420127,  -0.427878,   0.566186,
 };
 // clang-format on
+
+// POV-Ray's hash table as noise.cpp builds it (8192 entries: a permutation of 0..4095,
+// then the same again), for tests.
+std::span<const uint16_t, 8192> hashTable();
 
 }  // namespace pcsg::noise_detail

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "noise_patterns.h"
+#include "noise_tables.h"
 #include "normal_patterns.h"
 
 namespace pcsg {
@@ -54,6 +55,20 @@ TEST(Noise, RepeatsEvery4096CellsLikePovRays) {
         EXPECT_EQ(dnoise(q), dnoise(q + Vec3{4096, 4096, 4096}));
         EXPECT_NE(noise(q), noise(q + Vec3{2048, 0, 0}));
     }
+}
+
+TEST(Noise, HashTableIsAPermutationRepeatedOnce) {
+    const auto h = noise_detail::hashTable();
+    std::vector<int> seen(4096, 0);
+    for (int i = 0; i < 4096; ++i) {
+        ASSERT_LT(h[i], 4096);
+        ++seen[h[i]];
+        EXPECT_EQ(h[i], h[4096 + i]);
+    }
+    for (int count : seen) EXPECT_EQ(count, 1);
+    int fixed = 0;  // a shuffle, not the identity
+    for (int i = 0; i < 4096; ++i) fixed += h[i] == i;
+    EXPECT_LT(fixed, 20);
 }
 
 TEST(Noise, IsContinuousAcrossCellFaces) {
