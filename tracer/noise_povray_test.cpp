@@ -44,8 +44,8 @@ bool havePovray() {
     return std::system("command -v povray > /dev/null 2>&1") == 0;
 }
 
-// Reads a binary PPM (P6) with maxval 65535 (big-endian samples); returns the red channel
-// scaled to [0, 1]. POV-Ray writes comment lines in the header.
+// Reads a binary PPM (P6) with maxval 65535 (big-endian samples); returns the samples
+// (r, g, b per pixel) scaled to [0, 1]. POV-Ray writes comment lines in the header.
 std::vector<double> readPpm16(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     std::string magic;
@@ -67,10 +67,10 @@ std::vector<double> readPpm16(const fs::path& path) {
     std::vector<unsigned char> bytes(static_cast<size_t>(w) * h * 6);
     in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     if (!in) return {};
-    std::vector<double> red(static_cast<size_t>(w) * h);
-    for (size_t i = 0; i < red.size(); ++i)
-        red[i] = (bytes[i * 6] * 256 + bytes[i * 6 + 1]) / 65535.0;
-    return red;
+    std::vector<double> samples(static_cast<size_t>(w) * h * 3);
+    for (size_t i = 0; i < samples.size(); ++i)
+        samples[i] = (bytes[i * 2] * 256 + bytes[i * 2 + 1]) / 65535.0;
+    return samples;
 }
 
 fs::path workDir() {
@@ -78,8 +78,8 @@ fs::path workDir() {
            ("pcsg_noise_povray_" + std::to_string(static_cast<long>(getpid())));
 }
 
-// Renders `objects` (a plane and its texture) with the test camera; the red channel.
-std::vector<double> renderPov(const std::string& objects, const std::string& name) {
+// Renders `objects` (a plane and its texture) with the test camera: r, g, b per pixel.
+std::vector<double> renderPovRgb(const std::string& objects, const std::string& name) {
     const fs::path dir = workDir();
     fs::create_directories(dir);
     const fs::path pov = dir / (name + ".pov"), ppm = dir / (name + ".ppm");
@@ -93,6 +93,14 @@ std::vector<double> renderPov(const std::string& objects, const std::string& nam
                             " -A +FP16 -D File_Gamma=1.0 -GA > " + (dir / "log").string() + " 2>&1";
     if (std::system(cmd.c_str()) != 0) return {};
     return readPpm16(ppm);
+}
+
+// The red channel only (the grey images).
+std::vector<double> renderPov(const std::string& objects, const std::string& name) {
+    const std::vector<double> rgb = renderPovRgb(objects, name);
+    std::vector<double> red(rgb.size() / 3);
+    for (size_t i = 0; i < red.size(); ++i) red[i] = rgb[i * 3];
+    return red;
 }
 
 // Compares POV-Ray's image with expected(point) pixel by pixel: every pixel within `tol`.
@@ -245,6 +253,72 @@ TEST_F(NoisePovray, BozoAndTurbulenceToNineDigits) {
             }
         EXPECT_GT(compared, kW * kH * 9 / 10) << name;
         EXPECT_EQ(bad, 0) << name << ": " << bad << " of " << compared << " pixels differ";
+    }
+}
+
+// POV-Ray's colour map lookup (pattern.cpp Search_Blend_Map, pigment.cpp Compute_Pigment):
+// at or past the last entry its colour; else the first entry whose value is not below v
+// and the one before it, interpolated (equal values: that entry's colour).
+Vec3 mapColour(const std::vector<ColourMapEntry>& map, double v) {
+    size_t c = 0, prev = 0;
+    if (v >= map.back().value) {
+        prev = c = map.size() - 1;
+    } else {
+        while (v > map[c].value) prev = c++;
+    }
+    if (v == map[c].value) prev = c;
+    if (prev == c) return map[c].colour.rgb;
+    const double f = (v - map[prev].value) / (map[c].value - map[prev].value);
+    return map[prev].colour.rgb + (map[c].colour.rgb - map[prev].colour.rgb) * f;
+}
+
+// The raw values of checker and radial (pattern.cpp checker_pattern, radial_pattern), to
+// check their default colours too; the patterns branch implements them for real.
+double rawValue(const PatternSpec& s, const Vec3& q) {
+    if (s.kind == PatternKind::Checker) {
+        const double sum =
+            std::floor(q.x + 1e-10) + std::floor(q.y + 1e-10) + std::floor(q.z + 1e-10);
+        return (static_cast<long long>(sum) & 1) ? 1.0 : 0.0;
+    }
+    if (s.kind == PatternKind::Radial) return 0.25 + (std::atan2(q.x, q.z) + M_PI) / (2 * M_PI);
+    return noisePatternValue(s, q);
+}
+
+// patternDefaults' colour maps (and waves) against POV-Ray's when the pigment has no
+// color_map: bozo's own, spotted's grey, wood's, marble's, agate's, granite's grey,
+// checker's blue and green, radial's.
+TEST_F(NoisePovray, DefaultColourMaps) {
+    struct Case {
+        const char* text;
+        PatternKind kind;
+        bool spotted;
+    };
+    const Case cases[] = {
+        {"bozo", PatternKind::Bozo, false},       {"spotted", PatternKind::Bozo, true},
+        {"wood", PatternKind::Wood, false},       {"marble", PatternKind::Marble, false},
+        {"agate", PatternKind::Agate, false},     {"granite", PatternKind::Granite, false},
+        {"checker", PatternKind::Checker, false}, {"radial", PatternKind::Radial, false}};
+    for (const Case& c : cases) {
+        const PatternSpec s = spec(c.kind, Affine::scale({0.5, 0.5, 0.5}));
+        const PatternDefaults d = patternDefaults(c.kind, c.spotted);
+        const std::string name = std::string("map_") + c.text;
+        const std::vector<double> img =
+            renderPovRgb("plane { z, " + std::to_string(kPlaneZ) + " pigment { " + c.text +
+                             " scale 0.5 } finish { ambient 1 diffuse 0 } }",
+                         name);
+        ASSERT_EQ(img.size(), static_cast<size_t>(kW * kH * 3)) << name;
+        int bad = 0;
+        for (int py = 0; py < kH; ++py)
+            for (int px = 0; px < kW; ++px) {
+                const Vec3 p = pixelPoint(px, py);
+                const double raw = rawValue(s, s.toPattern.point(p));
+                const double v = d.continuous ? waveValue(raw, 1, 0, d.wave) : raw;
+                const Vec3 want = mapColour(d.colourMap, v);
+                const double* got = &img[(py * kW + px) * 3];
+                for (int k = 0; k < 3; ++k)
+                    if (std::fabs(got[k] - std::clamp(want[k], 0.0, 1.0)) > kTol) ++bad;
+            }
+        EXPECT_EQ(bad, 0) << name << ": " << bad << " samples differ";
     }
 }
 
