@@ -29,4 +29,16 @@ double turbulence(const Vec3& p, const Turbulence& t);
 // dnoise(lambda^i p) * omega^i. t.amount is not used here.
 Vec3 dturbulence(const Vec3& p, const Turbulence& t);
 
+// POV-Ray's wave sources, for the ripples and waves normals: with the default
+// `global_settings { number_of_waves 10 }`, source i is normalize(dnoise(<i, 0, 0>)) and its
+// frequency 0.01 + d * 0.000030518509476, d the i-th 15-bit draw ((r >> 16) & 0x7FFF) of the
+// generator r = r * 1812433253 + 12345 started at r = -560851967 (texture.cpp,
+// Initialize_Waves).
+struct NoiseWaves {
+    static constexpr int kCount = 10;
+    Vec3 source[kCount];
+    double frequency[kCount];
+};
+const NoiseWaves& noiseWaves();
+
 }  // namespace pcsg
