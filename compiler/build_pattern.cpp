@@ -310,6 +310,7 @@ bool readPigmentItem(BuildContext& ctx, PatternValues& v, AtomRange& r, const At
         }
         for (const PatternWord& w : kPatterns)
             if (w.name == n) p.pattern.kind = w.kind;
+        p.pattern.spotted = n == "spotted";
         reader.patternArguments(p.pattern);
         reader.listColours(p);
         return true;
