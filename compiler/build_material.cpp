@@ -7,6 +7,8 @@
 #include <optional>
 #include <string_view>
 
+#include "build_pattern.h"
+
 namespace pcsg {
 
 namespace {
@@ -16,20 +18,12 @@ constexpr uint8_t kConstant = 255;  // the field of a value that may not read th
 constexpr std::string_view kMaterialTakes =
     "color, ambient, diffuse, phong, phong_size, reflection and the blocks pigment, normal, "
     "finish, interior";
-constexpr std::string_view kPigmentTakes = "color (rgb, rgbf, rgbt, rgbft)";
 constexpr std::string_view kFinishTakes =
     "ambient, diffuse, brilliance, phong, phong_size, specular, roughness, metallic, reflection, "
     "conserve_energy";
 constexpr std::string_view kInteriorTakes = "ior";
 
 // Items of section 10 that the language defines and the renderers do not have yet.
-constexpr std::array<std::string_view, 26> kPigmentLater = {
-    "checker", "gradient",  "onion",      "leopard",   "radial",   "brick",      "hexagon",
-    "bozo",    "spotted",   "granite",    "wood",      "marble",   "agate",      "wrinkles",
-    "dents",   "color_map", "colour_map", "frequency", "phase",    "turbulence", "octaves",
-    "omega",   "lambda",    "scale",      "rotate",    "translate"};
-constexpr std::array<std::string_view, 5> kNormalLater = {"bumps", "dents", "wrinkles", "ripples",
-                                                          "waves"};
 constexpr std::array<std::string_view, 2> kInteriorLater = {"fade_distance", "fade_power"};
 
 template <size_t N>
@@ -44,7 +38,7 @@ bool isColourWord(std::string_view w) {
            w == "rgbft";
 }
 
-class MaterialReader {
+class MaterialReader : public PatternValues {
   public:
     MaterialReader(BuildContext& ctx, ExprCompiler& exprs, uint32_t index)
         : ctx_(ctx), ast_(ctx.ast), exprs_(exprs), m_(ctx.g.materials[index]), index_(index) {}
@@ -52,10 +46,18 @@ class MaterialReader {
     void body(const Stmt& s);
 
   private:
-    struct Range {
-        uint32_t i, end;
-        bool done() const { return i >= end; }
-    };
+    using Range = AtomRange;
+
+  public:  // PatternValues: the values of patterns, constants
+    std::optional<double> constant(const Atom& n) override { return value(n.expr, kConstant); }
+    std::optional<double> number(Range& r, const Atom& item) override {
+        return number(r, item, kConstant);
+    }
+    std::optional<FilterColour> colour(Range& r, const Atom& item) override;
+    std::optional<Vec3> vector(Range& r, const Atom& item, bool numberToo) override;
+    void skipValues(Range& r) override;
+
+  private:
     const Atom& peek(const Range& r) const { return ast_.atoms[r.i]; }
     bool nextIs(const Range& r, AtomKind k) const { return !r.done() && peek(r).kind == k; }
     std::string_view word(const Atom& a) const { return ctx_.text(a.tok); }
@@ -69,7 +71,6 @@ class MaterialReader {
     void setColour(const FilterColour& c);
     const Atom* block(Range& r, const Atom& item);
     bool flag(Range& r);
-    void skipValues(Range& r);
     void reject(Range& r, const Atom& item, std::string_view block, std::string_view takes);
 
     bool flatItem(Range& r, const Atom& item, std::string_view n);
@@ -164,6 +165,50 @@ std::optional<FilterColour> MaterialReader::colour(Range& r, const Atom& item, u
     return colourComponents(*model, ast_.atoms[r.i++], field);
 }
 
+// A pattern's colour (list colours, colour maps): a constant.
+std::optional<FilterColour> MaterialReader::colour(Range& r, const Atom& item) {
+    const auto c = colour(r, item, kConstant);
+    if (c && (c->filter != 0 || c->transmit != 0))
+        ctx_.error(colourTok_,
+                   "filter and transmit (transparency) are not implemented yet: they must be 0");
+    return c;
+}
+
+// A vector `<x, y, z>` after `item` (with numberToo, a number n is <n, n, n>): a constant.
+std::optional<Vec3> MaterialReader::vector(Range& r, const Atom& item, bool numberToo) {
+    if (numberToo && nextIs(r, AtomKind::Number)) {
+        const auto v = value(ast_.atoms[r.i++].expr, kConstant);
+        if (!v) return std::nullopt;
+        return Vec3{*v, *v, *v};
+    }
+    if (nextIs(r, AtomKind::Word)) {  // POV-Ray's x, y, z: the unit vectors
+        const std::string_view w = word(peek(r));
+        if (w == "x" || w == "y" || w == "z") {
+            ++r.i;
+            return Vec3{w == "x" ? 1.0 : 0.0, w == "y" ? 1.0 : 0.0, w == "z" ? 1.0 : 0.0};
+        }
+    }
+    if (!nextIs(r, AtomKind::Vector)) {
+        ctx_.error(item.tok, fmt::format("'{}' takes a vector '<x, y, z>'{}", clip(word(item)),
+                                         numberToo ? " or a number" : ""));
+        skipValues(r);
+        return std::nullopt;
+    }
+    const Atom& v = ast_.atoms[r.i++];
+    if (v.count != 3) {
+        ctx_.error(v.tok, fmt::format("'{}' takes a vector of 3 components, found {}",
+                                      clip(word(item)), v.count));
+        return std::nullopt;
+    }
+    Vec3 out;
+    for (int k = 0; k < 3; ++k) {
+        const auto x = value(ast_.lists[v.first + static_cast<uint32_t>(k)], kConstant);
+        if (!x) return std::nullopt;
+        out[k] = *x;
+    }
+    return out;
+}
+
 // The components of a colour vector `v` after the model word (or `color`).
 std::optional<FilterColour> MaterialReader::colourComponents(const Atom& model, const Atom& v,
                                                              uint8_t field) {
@@ -243,9 +288,7 @@ void MaterialReader::skipValues(Range& r) {
 void MaterialReader::reject(Range& r, const Atom& item, std::string_view block,
                             std::string_view takes) {
     const std::string_view n = word(item);
-    const bool later = (block == "pigment" && among(kPigmentLater, n)) ||
-                       (block == "normal" && among(kNormalLater, n)) ||
-                       (block == "interior" && among(kInteriorLater, n));
+    const bool later = block == "interior" && among(kInteriorLater, n);
     if (later)
         ctx_.error(item.tok, fmt::format("'{}' in {} is not implemented yet ({} takes {})", clip(n),
                                          block, block, takes));
@@ -319,11 +362,20 @@ void MaterialReader::pigment(Range r) {
             continue;
         }
         const std::string_view n = word(item);
-        if (isColourWord(n)) {
+        if (isColourWord(n) && m_.pigment.pattern.kind == PatternKind::Plain) {
             if (auto c = colour(r, item, 0)) setColour(*c);
             continue;
         }
-        reject(r, item, "pigment", kPigmentTakes);
+        if (isColourWord(n)) {
+            ctx_.error(item.tok, fmt::format("a pigment with a pattern takes its colours from "
+                                             "color_map or from the list after '{}', not from "
+                                             "'{}'",
+                                             patternName(m_.pigment.pattern.kind), clip(n)));
+            (void)colour(r, item, kConstant);  // read past it
+            continue;
+        }
+        if (!readPigmentItem(ctx_, *this, r, item, m_.pigment))
+            reject(r, item, "pigment", pigmentPatternItems());
     }
 }
 
@@ -430,7 +482,8 @@ void MaterialReader::normal(Range r) {
                        fmt::format("expected a normal item, found {}", describeAtom(item)));
             continue;
         }
-        reject(r, item, "normal", "no item yet");
+        if (!readNormalItem(ctx_, *this, r, item, m_.normal))
+            reject(r, item, "normal", normalPatternItems());
     }
 }
 

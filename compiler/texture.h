@@ -56,9 +56,16 @@ struct ColourMapEntry {
     FilterColour colour;
 };
 
+// One of a pattern's transformations as written (the exporter writes them back).
+struct PatternTransform {
+    enum Kind : uint8_t { Scale, Rotate, Translate } kind = Scale;
+    Vec3 v{1, 1, 1};
+};
+
 // What a pattern is and where it lives, shared by pigments and normals.
 struct PatternSpec {
     PatternKind kind = PatternKind::Plain;
+    bool spotted = false;       // Bozo written `spotted`: POV-Ray's grey default map
     Vec3 gradient{1, 0, 0};     // gradient's axis
     Vec3 brickSize{8, 3, 4.5};  // brick_size
     double mortar = 0.5;        // brick's mortar
@@ -71,6 +78,8 @@ struct PatternSpec {
     Affine toPattern = Affine::identity();
     Affine fromPattern = Affine::identity();  // its inverse (the transformations as written)
     bool transformed = false;
+    std::vector<PatternTransform> transforms;  // as written, in order
+    bool turbulenceWritten = false;            // turbulence, octaves, omega or lambda was written
 };
 
 struct Pigment {

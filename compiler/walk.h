@@ -27,7 +27,8 @@
 //   static constexpr bool kLocalSelectFrames = true;
 //   Result toParent(const Affine& selectToParent, const Result& local);
 // and optionally, to see where paint nodes stand (the exporter's textures on unions):
-//   void paint(uint32_t material, Result& r);   // r: the result of the paint's operand
+//   void paint(uint32_t material, const Affine& world, Result& r);
+//                         // r: the result of the paint's operand; world: the paint's frame
 // With kLocalSelectFrames the walk restarts `world` at the identity below each S-node,
 // lookup/store see results in the S-node's own frame, and toParent maps them into the
 // frame of the node that reached the S-node.
@@ -191,8 +192,9 @@ class Walker {
             sink_.store(e.node, e.depth, arena_.data() + e.frame, e.path, results_.back());
             results_.back() = fromSelect(e, results_.back());
         }
-        if constexpr (requires(Sink & s, Result & r) { s.paint(uint32_t{}, r); }) {
-            if (kind == NodeKind::Paint) sink_.paint(g_.nodes[e.node].payload, results_.back());
+        if constexpr (requires(Sink & s, Result & r) { s.paint(uint32_t{}, e.world, r); }) {
+            if (kind == NodeKind::Paint)
+                sink_.paint(g_.nodes[e.node].payload, e.world, results_.back());
         }
         // Frames are released in stack order: the C-node's child's is the last one.
         if (kind == NodeKind::Calc) arena_.resize(arena_.size() - frameSize_);

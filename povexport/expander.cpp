@@ -173,7 +173,8 @@ class TreeSink {
   public:
     using Result = uint32_t;  // a node id, or kNone for nothing
 
-    TreeSink(ExpandedTree& t, uint64_t maxNodes) : t_(t), maxNodes_(maxNodes) {}
+    TreeSink(const Graph& g, ExpandedTree& t, uint64_t maxNodes)
+        : g_(g), t_(t), maxNodes_(maxNodes) {}
 
     Result nothing() const { return kNone; }
     void visit() {}
@@ -218,9 +219,16 @@ class TreeSink {
         return static_cast<uint32_t>(t_.nodes.size() - 1);
     }
 
-    // The innermost paint wins: a node that has a texture keeps it.
-    void paint(uint32_t material, uint32_t& r) {
-        if (r != kNone && t_.nodes[r].texture == kNone) t_.nodes[r].texture = material;
+    // The innermost paint wins: a node that has a texture keeps it. A texture with a
+    // pattern keeps the paint node's frame (`world`), where POV-Ray must evaluate it.
+    void paint(uint32_t material, const Affine& world, uint32_t& r) {
+        if (r == kNone || t_.nodes[r].texture != kNone) return;
+        t_.nodes[r].texture = material;
+        const Material& m = g_.materials[material];
+        if (m.pigment.pattern.kind != PatternKind::Plain || m.normal.kind != NormalKind::None) {
+            t_.nodes[r].textureFrame = static_cast<uint32_t>(t_.textureFrames.size());
+            t_.textureFrames.push_back(world);
+        }
     }
 
   private:
@@ -236,6 +244,7 @@ class TreeSink {
         return kNone;
     }
 
+    const Graph& g_;
     ExpandedTree& t_;
     uint64_t maxNodes_;
 };
@@ -295,7 +304,7 @@ ExpandedTree expand(const Graph& g, const ExpandOptions& options) {
         tree.primitives.reserve(count.primitives);
         tree.args.reserve(count.args);
     }
-    TreeSink sink(tree, maxNodes);
+    TreeSink sink(g, tree, maxNodes);
     const Semantics sem(g);
     Walker<TreeSink> walker(sem, sink);
     try {

@@ -39,6 +39,9 @@ struct TreeNode {
     // that `paint(m)` over a big union is one texture, not a copy on each primitive. The
     // root has one (the default material, 0, if no paint stands there).
     uint32_t texture = kNone;
+    // For a texture with a pattern (section 10's pattern space): its paint node's frame,
+    // ExpandedTree::textureFrames[textureFrame] (kNone: a plain texture, no frame needed).
+    uint32_t textureFrame = kNone;
 
     bool is(CsgOp o) const { return !primitive && op == o; }
 };
@@ -50,7 +53,13 @@ struct ExpandedTree {
     std::vector<uint32_t> children;  // node ids, each operator's run in operand order
     std::vector<TreePrimitive> primitives;
     std::vector<double> args;
-    uint32_t root = kNone;  // kNone: the scene expands to nothing
+    std::vector<Affine> textureFrames;  // paint frames to world, of patterned textures
+    uint32_t root = kNone;              // kNone: the scene expands to nothing
+
+    const Affine* textureFrameOf(uint32_t n) const {
+        const uint32_t f = nodes[n].textureFrame;
+        return f == kNone ? nullptr : &textureFrames[f];
+    }
 
     const uint32_t* childrenOf(uint32_t n) const { return children.data() + nodes[n].first; }
     const TreePrimitive& primitiveOf(uint32_t n) const { return primitives[nodes[n].first]; }

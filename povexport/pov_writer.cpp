@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "pov_lights.h"
+#include "pov_texture.h"
 #include "primitive_table.h"
 
 namespace pcsg {
@@ -162,6 +163,14 @@ class Out {
     uint64_t written_ = 0;
 };
 
+bool isIdentity(const Affine& m) {
+    const Affine id = Affine::identity();
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            if (m.l[i][j] != id.l[i][j]) return false;
+    return m.t.x == 0 && m.t.y == 0 && m.t.z == 0;
+}
+
 // POV-Ray's matrix is p·M + t: the 3x3 part is L transposed, row by row.
 void putMatrix(Out& o, const Affine& m) {
     o.put(" matrix<");
@@ -220,9 +229,8 @@ void putTexture(Out& o, const Material& m) {
         o.put(" {} ", name);
         o.num(v);
     };
-    o.put("pigment {{ color rgb ");
-    o.vec(m.color);
-    o.put(" }} finish {{ ambient ");
+    o.raw(povPigment(m));
+    o.put(" finish {{ ambient ");
     o.num(m.ambient);
     o.put(" diffuse ");
     o.num(m.diffuse);
@@ -248,6 +256,7 @@ void putTexture(Out& o, const Material& m) {
     }
     if (m.conserveEnergy) o.put(" conserve_energy");
     o.put(" }}");
+    o.raw(povNormal(m));
 }
 
 void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& opt) {
@@ -317,13 +326,24 @@ Affine torusFrame() {
 
 // One primitive on one line. Returns false when it was left out.
 // ` texture{M<i>}` (or ` material{M<i>}`) for a node's own texture; nothing without one.
-void putTextureRef(Out& o, uint32_t texture, bool wrapped) {
-    if (texture != kNone) o.put(" {}{{M{}}}", wrapped ? "material" : "texture", texture);
+// A texture with a pattern carries its paint node's frame (`frame`: that frame to world):
+// POV-Ray evaluates it there (section 10's pattern space).
+void putTextureRef(Out& o, uint32_t texture, bool wrapped, const Affine* frame = nullptr) {
+    if (texture == kNone) return;
+    o.put(" {}{{M{}", wrapped ? "material" : "texture", texture);
+    if (frame && !isIdentity(*frame)) putMatrix(o, *frame);
+    o.put("}}");
 }
 
 bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_t texture,
-                  const std::string& indent, bool wrapped) {
-    const auto tex = [&] { putTextureRef(o, texture, wrapped); };
+                  const std::string& indent, bool wrapped, const Affine* frame) {
+    // A patterned texture in world space, after the object's matrix; a plain one before.
+    const auto tex = [&] {
+        if (!frame) putTextureRef(o, texture, wrapped);
+    };
+    const auto patterned = [&] {
+        if (frame) putTextureRef(o, texture, wrapped, frame);
+    };
     switch (p.kind) {
         case PrimitiveKind::Sphere:
         case PrimitiveKind::Cube:
@@ -333,6 +353,7 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_
             o.put("{}{}", indent, primitiveInfo(p.kind).pov);
             tex();
             putMatrix(o, p.toWorld);
+            patterned();
             break;
         case PrimitiveKind::Plane: {
             // In world coordinates, without a matrix: POV-Ray 3.7 cuts CSG wrongly next
@@ -348,6 +369,7 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_
             o.put(",");
             o.num(dot(n, p.toWorld.t));
             tex();
+            patterned();
             break;
         }
         case PrimitiveKind::Torus:
@@ -357,6 +379,7 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_
             o.num(t.args[p.firstArg + 1]);
             tex();
             putMatrix(o, p.toWorld * torusFrame());
+            patterned();
             break;
         case PrimitiveKind::Tri1:
         case PrimitiveKind::Tri2:
@@ -371,6 +394,7 @@ bool putPrimitive(Out& o, const ExpandedTree& t, const TreePrimitive& p, uint32_
             o.put(",");
             o.vec(c[2]);
             tex();
+            patterned();
             break;
         }
         case PrimitiveKind::Empty:
@@ -392,7 +416,8 @@ struct Item {
     std::vector<std::pair<size_t, size_t>> slices;  // a big group's sub-groups
     bool ownsMembers = false;  // this item pushed members[lo, hi) and pops them at the end
     Box box;
-    uint32_t texture = kNone;  // a group that replaces a union: the union's own texture
+    uint32_t texture = kNone;              // a group that replaces a union: the union's own texture
+    const Affine* textureFrame = nullptr;  // and its paint frame
 };
 
 class TreeWriter {
@@ -457,7 +482,7 @@ class TreeWriter {
         const Box& b = boxes_[it.node];
         const bool bound = !node.is(CsgOp::Union) || opt_.boundUnions;
         o_.put("{}", indent());
-        putTextureRef(o_, node.texture, wrapped_);
+        putTextureRef(o_, node.texture, wrapped_, t_.textureFrameOf(it.node));
         if (bound && boundable(b)) putBound(o_, b);
         o_.put(" }}\n");
         stack_.pop_back();
@@ -465,7 +490,8 @@ class TreeWriter {
 
     // Writes the primitive of the top item, node n, and pops it.
     void writePrimitive(uint32_t n) {
-        if (putPrimitive(o_, t_, t_.primitiveOf(n), t_.nodes[n].texture, indent(), wrapped_))
+        if (putPrimitive(o_, t_, t_.primitiveOf(n), t_.nodes[n].texture, indent(), wrapped_,
+                         t_.textureFrameOf(n)))
             ++stats_.objects;
         else
             ++stats_.skipped;
@@ -489,6 +515,7 @@ class TreeWriter {
         g.hi = members_.size();
         g.ownsMembers = true;
         g.texture = t_.nodes[n].texture;
+        g.textureFrame = t_.textureFrameOf(n);
         stack_.push_back(std::move(g));
     }
 
@@ -523,7 +550,7 @@ class TreeWriter {
             return;
         }
         o_.put("{}", indent());
-        putTextureRef(o_, it.texture, wrapped_);
+        putTextureRef(o_, it.texture, wrapped_, it.textureFrame);
         if (opt_.boundUnions && boundable(it.box)) putBound(o_, it.box);
         o_.put(" }}\n");
         finishGroup();

@@ -10,4 +10,8 @@ namespace pcsg::tracer {
 
 FilterColour pigmentColour(const Material& m, const SurfaceHit& hit);
 
+// A pigment with a pattern at a point in its paint node's frame (also the sky_sphere's,
+// at a direction).
+FilterColour pigmentAt(const Pigment& p, const Vec3& point);
+
 }  // namespace pcsg::tracer

@@ -6,6 +6,7 @@
 
 #include "fog.h"
 #include "lights.h"
+#include "perturb.h"
 #include "pigment.h"
 
 namespace pcsg::tracer {
@@ -142,6 +143,7 @@ Vec3 Shader::shade(const Ray& ray) {
         if (!isFinite(n)) n = -dir;  // degenerate normal (apex of a cone): face the viewer
         if (dot(n, dir) > 0) n = -n;
         const Material& m = g_.materials[hit.material < g_.materials.size() ? hit.material : 0];
+        if (m.normal.kind != NormalKind::None && hit.painted) n = perturbedNormal(m.normal, hit, n);
         const FilterColour pigment = pigmentColour(m, hit);
         colour += mul(local(p, n, dir, m, pigment.rgb), factor);
         const Reflectivity r = reflectivity(m, -dot(dir, n), pigment.rgb);

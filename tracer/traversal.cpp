@@ -43,11 +43,27 @@ uintptr_t threadStackLimit() {
 // ---------------------------------------------------------------------------------------
 // TraceScene
 
+// Materials whose pigment has a pattern need the hit point in their paint node's frame;
+// those with a normal pattern also the map into it. Scenes without either record nothing.
+void TraceScene::markPaintFrames() {
+    std::vector<uint8_t> marks(g_.materials.size(), 0);
+    bool any = false;
+    for (size_t i = 0; i < marks.size(); ++i) {
+        const Material& m = g_.materials[i];
+        if (m.pigment.pattern.kind != PatternKind::Plain) marks[i] |= kPaintPoint;
+        if (m.normal.kind != NormalKind::None) marks[i] |= kPaintPoint | kPaintMap;
+        any = any || marks[i] != 0;
+        paintMaps = paintMaps || (marks[i] & kPaintMap);
+    }
+    if (any) paintFrames = std::move(marks);
+}
+
 TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
                        const InstanceBoxOptions& instanceBoxOptions)
     : g_(g), sem_(g), memoPlan_(g), bounds_(std::move(bounds)) {
     const size_t n = g.nodes.size();
     if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
+    markPaintFrames();
     if (useInstanceBoxes && !g.modules.empty())
         instanceBoxes_ = std::make_unique<InstanceBoxes>(g, bounds_, instanceBoxOptions);
     // Longest chain of nested visits between two S-nodes (the graph without the edges into
@@ -154,6 +170,8 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     spans_.clear();
     order_.clear();
     paintRays_.clear();
+    paintMaps_.clear();
+    inverses_.clear();
     if (g_.axiom == kNone) return false;
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
@@ -171,6 +189,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     if (out.painted) {
         const LocalRay& p = paintRays_[hit.paint - 1];
         out.paintPoint = p.o + p.d * hit.t;
+        if (scene_.paintMaps) out.paintMap = paintMaps_[hit.paint - 1];
     }
     return true;
 }
@@ -220,16 +239,28 @@ template <class Below, class Unrolled, class TransformBack>
     if (kind == NodeKind::Paint && !anyHit_ && scene_.paintFrameOf(st.state.material)) {
         paintRays_.push_back(r);  // a paint node keeps the frame: r is the ray in its frame
         st.state.paint = static_cast<uint32_t>(paintRays_.size());
+        if (scene_.paintMaps) paintMaps_.push_back(paintMapHere(st.state.material));
     }
     Result found;
     if (st.inverse) {
         const LocalRay rr{st.inverse->point(r.o), st.inverse->vector(r.d)};
+        if (scene_.paintMaps && !anyHit_) inverses_.push_back(st.inverse);
         found = transformBack(*st.inverse, [&] { return below(st.child, rr, st.state); });
+        if (scene_.paintMaps && !anyHit_) inverses_.pop_back();
     } else {
         found = below(st.child, r, st.state);
     }
     if (kind == NodeKind::Calc) frames_.pop();
     return found;
+}
+
+// The map from the world into the frame of the paint node being visited, for a material
+// with a normal pattern: the T-nodes' inverses above it, composed.
+Affine Tracer::paintMapHere(uint32_t material) const {
+    Affine m = Affine::identity();
+    if (!scene_.paintMapOf(material)) return m;
+    for (const Affine* inv : inverses_) m = *inv * m;
+    return m;
 }
 
 bool Tracer::firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,

@@ -66,6 +66,9 @@ struct SurfaceHit {
     // paint node that applied the material.
     bool painted = false;
     Vec3 paintPoint;
+    // Materials with a normal pattern (TraceScene::kPaintMap): the map of points from the
+    // world into the paint node's frame.
+    Affine paintMap;
 };
 
 // The graph with everything the walk precomputes once: its semantics (with the fused
@@ -101,14 +104,21 @@ class TraceScene {
     const Semantics& semantics() const { return sem_; }
 
     // Per material: whether a hit needs the point in its paint node's frame (its pigment
-    // has a pattern). Empty: none does, and the walk records no frames.
+    // has a pattern: kPaintPoint), and the map into that frame too (its normal has a
+    // pattern: kPaintMap). Empty: none does, and the walk records no frames.
     std::vector<uint8_t> paintFrames;
+    static constexpr uint8_t kPaintPoint = 1, kPaintMap = 2;
+    bool paintMaps = false;  // some material needs kPaintMap
+    bool paintMapOf(uint32_t material) const {
+        return material < paintFrames.size() && (paintFrames[material] & kPaintMap);
+    }
     bool paintFrameOf(uint32_t material) const {
         return material < paintFrames.size() && paintFrames[material];
     }
 
   private:
     friend class Tracer;
+    void markPaintFrames();
     const Graph& g_;
     Semantics sem_;
     StepMemoPlan memoPlan_;
@@ -181,6 +191,7 @@ class Tracer {
                Unrolled unrolled, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
     void checkStack();
+    Affine paintMapHere(uint32_t material) const;
 
     const TraceScene& scene_;
     const Graph& g_;
@@ -193,6 +204,11 @@ class Tracer {
     std::vector<std::pair<double, uint32_t>> order_;
     std::vector<LocalRay>
         paintRays_;  // the ray in the frame of each paint node (PathState::paint - 1)
+    // With TraceScene::paintMaps: the inverse matrices of the T-nodes above the node being
+    // visited, outermost first, and the map from the world into each paint node's frame
+    // (beside paintRays_; identity where the material has no normal pattern).
+    std::vector<const Affine*> inverses_;
+    std::vector<Affine> paintMaps_;
     bool anyHit_ = false;
     uint64_t visits_ = 0;
     uintptr_t stackLimit_ = 0;

@@ -7,6 +7,7 @@
 //  - primitive intersection (each solid, the triangle);
 //  - span-list combination (∪ ∩ \ of two lists);
 //  - one selection and C-node step of the one semantics (Sierpinski, terrain);
+//  - POV-Ray's noise, turbulence, a noise pattern and two normals (noise_bench.cpp);
 //  - a whole first-hit walk of a camera ray through the cyclic graph (Sierpinski order 8,
 //    with the static boxes alone and with the exact instance boxes).
 #include <benchmark/benchmark.h>
