@@ -310,11 +310,7 @@ bool readPigmentItem(BuildContext& ctx, PatternValues& v, AtomRange& r, const At
         }
         for (const PatternWord& w : kPatterns)
             if (w.name == n) p.pattern.kind = w.kind;
-        // spotted is bozo with POV-Ray's grey default map, not bozo's (pigment.cpp
-        // Post_Pigment); a color_map written after it replaces this one.
-        if (n == "spotted")
-            p.colourMap = {ColourMapEntry{0, FilterColour{{0, 0, 0}}},
-                           ColourMapEntry{1, FilterColour{{1, 1, 1}}}};
+        p.pattern.spotted = n == "spotted";
         reader.patternArguments(p.pattern);
         reader.listColours(p);
         return true;

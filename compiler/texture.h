@@ -65,6 +65,7 @@ struct PatternTransform {
 // What a pattern is and where it lives, shared by pigments and normals.
 struct PatternSpec {
     PatternKind kind = PatternKind::Plain;
+    bool spotted = false;       // Bozo written `spotted`: POV-Ray's grey default map
     Vec3 gradient{1, 0, 0};     // gradient's axis
     Vec3 brickSize{8, 3, 4.5};  // brick_size
     double mortar = 0.5;        // brick's mortar

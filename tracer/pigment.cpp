@@ -8,7 +8,9 @@ namespace pcsg::tracer {
 FilterColour pigmentAt(const Pigment& p, const Vec3& point) {
     const double v = patternValue(p.pattern, point);
     if (isListPattern(p.pattern.kind)) return listColour(p, v);
-    return colourMapLookup(p.hasColourMap() ? p.colourMap : defaultColourMap(p.pattern.kind), v);
+    if (p.hasColourMap()) return colourMapLookup(p.colourMap, v);
+    const PatternKind mapOf = p.pattern.spotted ? PatternKind::Gradient : p.pattern.kind;
+    return colourMapLookup(defaultColourMap(mapOf), v);  // spotted: the grey map
 }
 
 FilterColour pigmentColour(const Material& m, const SurfaceHit& hit) {

@@ -1,6 +1,6 @@
 // tests/scenes/pattern_space_probe.pcsg written by hand in POV-Ray's own syntax: a texture
 // given before an object's transformations moves with it, one given after them does not;
-// a pattern's scale, rotate, translate, frequency and phase.
+// a pattern's scale, rotate, translate, frequency and phase; a normal on a transformed object.
 // `pcsg verify tests/scenes/pattern_space_probe.pcsg --pov tests/povray/pattern_space_probe.pov`
 // must agree.
 //
@@ -39,4 +39,10 @@ sphere { 0, 1
                                              [0.5 rgb <0.1, 0.4, 0.3>] [1 rgb <0.1, 0.4, 0.3>] }
                       scale 0.3 } }
   scale <0.7, 0.7, 0.9> rotate x * 20 rotate z * 35 translate <0, -0.9, 0.7>
+}
+sphere { 0, 1
+  texture { pigment { color rgb <0.8, 0.75, 0.3> }
+            normal { ripples 1.5 frequency 3 translate <0, 0, 0.4> }
+            finish { phong 0.6 phong_size 40 } }
+  scale <0.3, 0.8, 0.55> rotate x * 50 rotate z * 60 translate <1.9, -0.8, 0.6>
 }
