@@ -1,0 +1,131 @@
+// The ray tree of shading.h: POV-Ray 3.7's TraceRay and the single-layer case of its
+// ComputeLightedTexture, with the transparency of transparency.h.
+#include <cmath>
+
+#include "pigment.h"
+#include "shading.h"
+
+namespace pcsg::tracer {
+
+using C = ShadingConstants;
+
+// A hit being shaded: where, the normal facing the ray, the material and its pigment there.
+struct Shader::Surface {
+    const TreeRay& ray;
+    int level;  // the trace level of the ray that hit (the camera ray's hit: 1)
+    double t;
+    Vec3 p, n;
+    uint32_t material;
+    const Material& m;
+    FilterColour pigment;
+    Reflectivity reflection;
+};
+
+Vec3 Shader::trace(const TreeRay& ray, double weight, bool continued) {
+    const Settings& st = g_.scene.settings;
+    if (ray.level >= static_cast<int>(st.maxTraceLevel) || weight < st.adcBailout)
+        return Vec3{0, 0, 0};
+    ++rays_;
+    SurfaceHit hit;
+    if (!tracer_.firstHit(ray.origin, ray.dir, C::kMinIsectDepth, C::kMaxDistance, hit))
+        return g_.scene.background;
+    Vec3 n = normalize(hit.normal);
+    if (!isFinite(n)) n = -ray.dir;  // degenerate normal (apex of a cone): face the viewer
+    if (dot(n, ray.dir) > 0) n = -n;
+    const uint32_t mi = hit.material < g_.materials.size() ? hit.material : 0;
+    const Material& m = g_.materials[mi];
+    const FilterColour pigment = pigmentColour(m, hit);
+    const double cosIncidence = -dot(ray.dir, n);
+    const Surface s{ray,
+                    continued ? ray.level : ray.level + 1,
+                    hit.t,
+                    ray.origin + ray.dir * hit.t,
+                    n,
+                    mi,
+                    m,
+                    pigment,
+                    reflectivity(m, cosIncidence, pigment.rgb, relativeIor(ray.inside, mi, g_))};
+    return shadeSurface(s, weight);
+}
+
+// ComputeLightedTexture for one layer: the local colour scaled by the opacity, the
+// transmitted ray filtered by what the pigment lets through, the reflected ray unless the
+// transmitted one was totally reflected.
+Vec3 Shader::shadeSurface(const Surface& s, double weight) {
+    Vec3 colour =
+        local(s.p, s.n, s.ray.dir, s.m, s.pigment.rgb, opacity(s.pigment), s.ray.inside);
+    bool totalReflection = false;
+    if (isTransparent(s.pigment)) colour += transmitted(s, weight, totalReflection);
+    const Vec3& r = s.reflection.colour;
+    if (!totalReflection && (r.x != 0 || r.y != 0 || r.z != 0))
+        colour += mul(r, reflected(s, weight * s.reflection.weight));
+    return colour;
+}
+
+// The light through the surface (ComputeRefraction, TraceRefractionRay): a straight ray
+// between equal iors, a refracted one, or on total internal reflection the reflected ray.
+Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection) {
+    Vec3 passes = transmittedColour(s.pigment);
+    if (s.m.conserveEnergy) passes = conserveEnergy(passes, s.reflection.colour);
+    const double trans = std::min(1.0, std::fabs(greyscale(passes)));
+    const double bailout = g_.scene.settings.adcBailout;
+    if (!(trans > bailout)) return Vec3{0, 0, 0};
+    const double w = weight * maxAbs(passes);
+    TreeRay next{s.p, s.ray.dir, s.level, s.ray.inside};
+    const double ior = crossSurface(next.inside, s.material, g_);
+    Vec3 light;
+    if (std::fabs(ior - 1.0) < C::kEpsilon) {
+        light = trace(next, w, true);
+    } else if (const auto d = refractDirection(s.ray.dir, s.n, ior)) {
+        next.dir = normalize(*d);
+        light = trace(next, w, false);
+    } else {
+        totalReflection = true;
+        light = reflected(s, w);
+    }
+    // Light that travelled inside this interior fades on the way.
+    if (s.ray.inside.contains(s.material)) light = mul(light, fade(s.m, s.t));
+    return totalReflection ? light : mul(light, passes);
+}
+
+// The ray mirrored at the surface (ComputeReflection), in the incoming ray's interiors.
+Vec3 Shader::reflected(const Surface& s, double weight) {
+    const Vec3 d = normalize(s.ray.dir - s.n * (2 * dot(s.ray.dir, s.n)));
+    return trace(TreeRay{s.p, d, s.level, s.ray.inside}, weight, false);
+}
+
+// TracePointLightShadowRay with ComputeShadowColour: the shadow ray goes on through every
+// surface that lets light through, filtered by it (and faded inside the interiors of the
+// ray being lit), until the light or an opaque surface.
+Vec3 Shader::shadowFilter(const Vec3& p, const Vec3& l, double dist, const Interiors& inside) {
+    ++rays_;
+    if (!anyTransparent_)
+        return tracer_.anyHit(p, l, C::kShadowTolerance, dist - C::kShadowTolerance)
+                   ? Vec3{0, 0, 0}
+                   : Vec3{1, 1, 1};
+    Vec3 filter{1, 1, 1}, origin = p;
+    double remaining = dist;
+    const double bailout = g_.scene.settings.adcBailout;
+    SurfaceHit hit;
+    while (tracer_.firstHit(origin, l, C::kShadowTolerance, remaining - C::kShadowTolerance,
+                            hit)) {
+        const uint32_t mi = hit.material < g_.materials.size() ? hit.material : 0;
+        const Material& m = g_.materials[mi];
+        const FilterColour pigment = pigmentColour(m, hit);
+        if (!isTransparent(pigment)) return Vec3{0, 0, 0};
+        Vec3 through = transmittedColour(pigment);
+        if (inside.contains(mi)) through = mul(through, fade(m, hit.t, true));
+        if ((std::fabs(through.x) + std::fabs(through.y) + std::fabs(through.z)) / 3 < bailout)
+            return Vec3{0, 0, 0};
+        filter = mul(filter, through);
+        if (std::fabs(filter.x) < C::kEpsilon && std::fabs(filter.y) < C::kEpsilon &&
+            std::fabs(filter.z) < C::kEpsilon)
+            return Vec3{0, 0, 0};
+        origin = origin + l * hit.t;
+        remaining -= hit.t;
+        ++rays_;
+    }
+    return filter;
+}
+
+}  // namespace pcsg::tracer
