@@ -261,13 +261,15 @@ bool MaterialReader::interiorItem(Range& r, const Atom& item, std::string_view n
             m_.ior = *v;
         }
     } else if (n == "fade_distance" || n == "fade_power") {
-        if (auto v = number(r, item, kConstant)) (n == "fade_power" ? m_.fadePower : m_.fadeDistance) = *v;
+        if (auto v = number(r, item, kConstant))
+            (n == "fade_power" ? m_.fadePower : m_.fadeDistance) = *v;
     } else if (n == "fade_color" || n == "fade_colour") {
         if (nextIs(r, AtomKind::Word) && isColourWord(word(peek(r)))) {
             const Atom& model = ast_.atoms[r.i++];
             if (auto c = colour(r, model, kConstant)) m_.fadeColour = c->rgb;
         } else if (nextIs(r, AtomKind::Vector)) {
-            if (auto c = colourComponents(item, ast_.atoms[r.i++], kConstant)) m_.fadeColour = c->rgb;
+            if (auto c = colourComponents(item, ast_.atoms[r.i++], kConstant))
+                m_.fadeColour = c->rgb;
         } else {
             ctx_.error(item.tok, fmt::format("'{}' takes a colour", clip(n)));
             skipValues(r);

@@ -121,10 +121,12 @@ std::optional<double> DirectiveReader::wantScalar(const DirectiveItem& item, uin
     return value(item.e[0], field);
 }
 
+constexpr const char* kSettingsTakes = "seed, max_depth, max_trace_level, adc_bailout";
+
 void DirectiveReader::settings(const Stmt& s) {
     if (!once(settingsSeen_, s, "settings")) return;
     Settings& st = g_.scene.settings;
-    items(s, "settings", "seed, max_depth, max_trace_level, adc_bailout", [&](std::string_view n, const DirectiveItem& item) {
+    items(s, "settings", kSettingsTakes, [&](std::string_view n, const DirectiveItem& item) {
         if (n == "seed") {
             if (auto v = wantScalar(item, kSetting)) {
                 if (*v < 0 || *v != std::floor(*v) || *v > 9007199254740992.0)
@@ -160,9 +162,9 @@ void DirectiveReader::traceSetting(std::string_view n, const DirectiveItem& item
     if (!v) return;
     if (n == "max_trace_level") {
         if (*v < 1 || *v != std::floor(*v) || *v > 256)
-            ctx_.error(item.nameTok,
-                       fmt::format("max_trace_level must be a whole number from 1 to 256, found {}",
-                                   *v));
+            ctx_.error(
+                item.nameTok,
+                fmt::format("max_trace_level must be a whole number from 1 to 256, found {}", *v));
         else
             st.maxTraceLevel = static_cast<uint32_t>(*v);
     } else if (*v < 0 || *v > 1) {

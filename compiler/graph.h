@@ -252,8 +252,8 @@ struct Material {
     double fadeDistance = 0;
     double fadePower = 0;
     Vec3 fadeColour{0, 0, 0};
-    Pigment pigment{};      // its pattern (PatternKind::Plain: color, filter, transmit)
-    NormalSpec normal{};    // NormalKind::None: the surface's own normal
+    Pigment pigment{};    // its pattern (PatternKind::Plain: color, filter, transmit)
+    NormalSpec normal{};  // NormalKind::None: the surface's own normal
 
     double minReflection() const { return reflectionRange ? reflectionMin : reflection; }
 };

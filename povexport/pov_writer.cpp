@@ -286,7 +286,8 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
     o.put("// render: povray +I<file> +W{} +H{} (the camera's aspect is {}:{})\n", opt.width,
           opt.height, opt.width, opt.height);
     o.put("#version 3.7;\n");
-    o.put("global_settings {{ assumed_gamma 1.0 max_trace_level {}", g.scene.settings.maxTraceLevel);
+    o.put("global_settings {{ assumed_gamma 1.0 max_trace_level {}",
+          g.scene.settings.maxTraceLevel);
     if (g.scene.settings.adcBailout != 1.0 / 255.0) {
         o.put(" adc_bailout ");
         o.num(g.scene.settings.adcBailout);

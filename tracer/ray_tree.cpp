@@ -52,8 +52,7 @@ Vec3 Shader::trace(const TreeRay& ray, double weight, bool continued) {
 // transmitted ray filtered by what the pigment lets through, the reflected ray unless the
 // transmitted one was totally reflected.
 Vec3 Shader::shadeSurface(const Surface& s, double weight) {
-    Vec3 colour =
-        local(s.p, s.n, s.ray.dir, s.m, s.pigment.rgb, opacity(s.pigment), s.ray.inside);
+    Vec3 colour = local(s.p, s.n, s.ray.dir, s.m, s.pigment.rgb, opacity(s.pigment), s.ray.inside);
     bool totalReflection = false;
     if (isTransparent(s.pigment)) colour += transmitted(s, weight, totalReflection);
     const Vec3& r = s.reflection.colour;
@@ -107,8 +106,7 @@ Vec3 Shader::shadowFilter(const Vec3& p, const Vec3& l, double dist, const Inter
     double remaining = dist;
     const double bailout = g_.scene.settings.adcBailout;
     SurfaceHit hit;
-    while (tracer_.firstHit(origin, l, C::kShadowTolerance, remaining - C::kShadowTolerance,
-                            hit)) {
+    while (tracer_.firstHit(origin, l, C::kShadowTolerance, remaining - C::kShadowTolerance, hit)) {
         const uint32_t mi = hit.material < g_.materials.size() ? hit.material : 0;
         const Material& m = g_.materials[mi];
         const FilterColour pigment = pigmentColour(m, hit);

@@ -122,6 +122,8 @@ Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pi
     return out;
 }
 
-Vec3 Shader::shade(const Ray& ray) { return trace(TreeRay{ray.origin, ray.dir, 0, Interiors{}}, 1.0, false); }
+Vec3 Shader::shade(const Ray& ray) {
+    return trace(TreeRay{ray.origin, ray.dir, 0, Interiors{}}, 1.0, false);
+}
 
 }  // namespace pcsg::tracer

@@ -73,10 +73,16 @@ std::optional<Vec3> refractDirection(const Vec3& d, const Vec3& n, double ior);
 inline Vec3 transmittedColour(const FilterColour& c) {
     return c.rgb * c.filter + Vec3{c.transmit, c.transmit, c.transmit};
 }
-inline double opacity(const FilterColour& c) { return 1.0 - c.filter - c.transmit; }
-inline double greyscale(const Vec3& c) { return 0.297 * c.x + 0.589 * c.y + 0.114 * c.z; }
+inline double opacity(const FilterColour& c) {
+    return 1.0 - c.filter - c.transmit;
+}
+inline double greyscale(const Vec3& c) {
+    return 0.297 * c.x + 0.589 * c.y + 0.114 * c.z;
+}
 double maxAbs(const Vec3& c);
-inline bool isTransparent(const FilterColour& c) { return c.filter != 0 || c.transmit != 0; }
+inline bool isTransparent(const FilterColour& c) {
+    return c.filter != 0 || c.transmit != 0;
+}
 
 // conserve_energy: what passes, times min(1 - reflectivity, 1) per channel.
 Vec3 conserveEnergy(const Vec3& passes, const Vec3& reflectivity);

@@ -97,9 +97,10 @@ TEST(Transparency, ConserveEnergyTakesTheReflectedShare) {
 
 // One camera ray through a thin transparent box onto a wall lit by ambient only.
 double throughVeil(const std::string& veil, const std::string& settings) {
-    const std::string text = settings + "\nmaterial wall { color <0.2, 0.4, 0.8> ambient 1 diffuse 0 }\n" +
-                             "material veil { " + veil + " ambient 0.5 diffuse 0 }\n" +
-                             "paint(wall) move(0, 0, -5) plane ∪ paint(veil) scale(3, 3, 0.1) cube\n";
+    const std::string text =
+        settings + "\nmaterial wall { color <0.2, 0.4, 0.8> ambient 1 diffuse 0 }\n" +
+        "material veil { " + veil + " ambient 0.5 diffuse 0 }\n" +
+        "paint(wall) move(0, 0, -5) plane ∪ paint(veil) scale(3, 3, 0.1) cube\n";
     auto c = compile(text);
     if (!c->graph) return -1;
     const Graph& g = *c->graph;
@@ -126,12 +127,12 @@ TEST(Transparency, StraightThroughKeepsTheTraceLevelRefractionDoesNot) {
     // Every ray is checked against max_trace_level, but the rays straight through (ior 1)
     // keep the camera ray's level 1: at level 2 they reach the wall through both walls.
     EXPECT_NEAR(throughVeil(plain, "settings { max_trace_level 1 }"), own, 1e-12);
-    EXPECT_NEAR(throughVeil(plain, "settings { max_trace_level 2 }"), own + 0.6 * (own + 0.6 * wall),
-                1e-12);
+    EXPECT_NEAR(throughVeil(plain, "settings { max_trace_level 2 }"),
+                own + 0.6 * (own + 0.6 * wall), 1e-12);
     // ior 1.5: the refracted ray inside is level 2, the one leaving level 3.
     EXPECT_NEAR(throughVeil(glass, "settings { max_trace_level 2 }"), own + 0.6 * own, 1e-12);
-    EXPECT_NEAR(throughVeil(glass, "settings { max_trace_level 3 }"), own + 0.6 * (own + 0.6 * wall),
-                1e-12);
+    EXPECT_NEAR(throughVeil(glass, "settings { max_trace_level 3 }"),
+                own + 0.6 * (own + 0.6 * wall), 1e-12);
 }
 
 TEST(Transparency, WeightBelowAdcBailoutIsNotTraced) {
