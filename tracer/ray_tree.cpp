@@ -23,7 +23,8 @@ struct Shader::Surface {
 
 Vec3 Shader::trace(const TreeRay& ray, double weight, bool continued) {
     const Settings& st = g_.scene.settings;
-    if (ray.level >= static_cast<int>(st.maxTraceLevel) || weight < st.adcBailout)
+    if (ray.level >= static_cast<int>(st.maxTraceLevel) || weight < st.adcBailout ||
+        ray.straight > kMaxStraight)
         return Vec3{0, 0, 0};
     ++rays_;
     SurfaceHit hit;
@@ -70,10 +71,11 @@ Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection)
     const double bailout = g_.scene.settings.adcBailout;
     if (!(trans > bailout)) return Vec3{0, 0, 0};
     const double w = weight * maxAbs(passes);
-    TreeRay next{s.p, s.ray.dir, s.level, s.ray.inside};
+    TreeRay next{s.p, s.ray.dir, s.level, s.ray.inside, s.ray.straight};
     const double ior = crossSurface(next.inside, s.material, g_);
     Vec3 light;
     if (std::fabs(ior - 1.0) < C::kEpsilon) {
+        next.straight = s.ray.straight + 1;
         light = trace(next, w, true);
     } else if (const auto d = refractDirection(s.ray.dir, s.n, ior)) {
         next.dir = normalize(*d);
@@ -90,7 +92,7 @@ Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection)
 // The ray mirrored at the surface (ComputeReflection), in the incoming ray's interiors.
 Vec3 Shader::reflected(const Surface& s, double weight) {
     const Vec3 d = normalize(s.ray.dir - s.n * (2 * dot(s.ray.dir, s.n)));
-    return trace(TreeRay{s.p, d, s.level, s.ray.inside}, weight, false);
+    return trace(TreeRay{s.p, d, s.level, s.ray.inside, s.ray.straight}, weight, false);
 }
 
 // TracePointLightShadowRay with ComputeShadowColour: the shadow ray goes on through every

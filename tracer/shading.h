@@ -46,7 +46,9 @@
 //    filtered shadows). A ray whose weight is below adc_bailout (settings, default 1/255)
 //    or whose parent is at max_trace_level (settings, default 5: the camera ray is level 1)
 //    is black; a ray continued straight through a surface between equal iors keeps its
-//    parent's level.
+//    parent's level (POV-Ray's continued ray), and beyond 512 such rays on one path of the
+//    tree is black too (a bound on the recursion that POV-Ray does not have; only rays
+//    through hundreds of fully transparent walls reach it).
 //  - Materials: POV-Ray's defaults for items left out (graph.h's Material), colour <1,1,1>
 //    for the default material.
 //  - Output: linear colours; images are encoded as sRGB (render.h) as POV-Ray 3.7 does with
@@ -106,7 +108,11 @@ class Shader {
         Vec3 origin, dir;
         int level = 0;
         Interiors inside;
+        int straight = 0;  // rays continued straight on along its path (at most kMaxStraight)
     };
+    // A bound on the C++ recursion of rays continued straight through surfaces (which do
+    // not count trace levels): past it a ray is black, as one past max_trace_level.
+    static constexpr int kMaxStraight = 512;
     struct Surface;  // a hit being shaded (ray_tree.cpp)
     Vec3 trace(const TreeRay& ray, double weight, bool continued);
     Vec3 shadeSurface(const Surface& s, double weight);
