@@ -95,15 +95,18 @@ Vec3 Shader::reflected(const Surface& s, double weight) {
     return trace(TreeRay{s.p, d, s.level, s.ray.inside, s.ray.straight}, weight, false);
 }
 
-// TracePointLightShadowRay with ComputeShadowColour: the shadow ray goes on through every
-// surface that lets light through, filtered by it (and faded inside the interiors of the
-// ray being lit), until the light or an opaque surface.
-Vec3 Shader::shadowFilter(const Vec3& p, const Vec3& l, double dist, const Interiors& inside) {
+// TracePointLightShadowRay with ComputeShadowColour and ComputeShadowMedia: the shadow ray
+// goes on through every surface that lets light through, filtered by it, until the light or
+// an opaque surface. It starts in the interiors of the ray being lit and enters or leaves
+// the interior of each surface it crosses (leaving when it is in it), so a stretch inside a
+// fading interior fades.
+Vec3 Shader::shadowFilter(const Vec3& p, const Vec3& l, double dist, const Interiors& lit) {
     ++rays_;
     if (!anyTransparent_)
         return tracer_.anyHit(p, l, C::kShadowTolerance, dist - C::kShadowTolerance)
                    ? Vec3{0, 0, 0}
                    : Vec3{1, 1, 1};
+    Interiors inside = lit;  // the shadow ray enters and leaves interiors on its way
     Vec3 filter{1, 1, 1}, origin = p;
     double remaining = dist;
     const double bailout = g_.scene.settings.adcBailout;
@@ -115,6 +118,7 @@ Vec3 Shader::shadowFilter(const Vec3& p, const Vec3& l, double dist, const Inter
         if (!isTransparent(pigment)) return Vec3{0, 0, 0};
         Vec3 through = transmittedColour(pigment);
         if (inside.contains(mi)) through = mul(through, fade(m, hit.t, true));
+        if (!inside.remove(mi)) inside.push(mi);
         if ((std::fabs(through.x) + std::fabs(through.y) + std::fabs(through.z)) / 3 < bailout)
             return Vec3{0, 0, 0};
         filter = mul(filter, through);

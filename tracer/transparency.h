@@ -24,8 +24,10 @@
 //    filtered).
 //  - Fade (interior fade_distance d, fade_power p, fade_color c) applies to a ray whose stack
 //    holds the surface's interior, over the distance t travelled inside: p >= 1000 gives
-//    exp(-(1 - c) t / d), else c + (1 - c) / (1 + (t / d)^p). Shadow rays (with p > 0 only)
-//    use the stack of the ray whose hit they light, as POV-Ray does.
+//    exp(-(1 - c) t / d), else c + (1 - c) / (1 + (t / d)^p). Shadow rays fade too (with
+//    p > 0 only): each starts with the stack of the ray whose hit it lights and toggles the
+//    interior of every surface it crosses (POV-Ray's ComputeShadowMedia), so the stretch
+//    from a solid's near wall to its far wall fades.
 //  - Shadows: a shadow ray is multiplied by what each surface it crosses lets through
 //    (both walls of a solid); weight (|r| + |g| + |b|) / 3 below adc_bailout is black. No
 //    caustics, no refraction of shadow rays.

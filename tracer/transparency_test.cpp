@@ -167,5 +167,26 @@ paint(ground) plane ∪ paint(tint) move(0, 0, 3) cube
     EXPECT_NEAR(col.z, 0.2 * 0.2, 1e-9);
 }
 
+// The same through a fading box: the shadow ray enters the box at its top wall and fades
+// over the 2 units to its bottom wall, 1 / (1 + (2 / 1)^2) with fade_power 2.
+TEST(Transparency, ShadowRaysFadeInsideTheSolidsTheyCross) {
+    auto c = compile(R"(
+light { position <0, 0.5, 10>  color <1, 1, 1> }
+material ground { color <1, 1, 1> ambient 0 diffuse 1 }
+material tint { color rgbt <1, 1, 1, 1> ambient 0 diffuse 0
+                interior { fade_distance 1 fade_power 2 fade_color <0.5, 0, 0> } }
+paint(ground) plane ∪ paint(tint) move(0, 0, 3) cube
+)");
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene scene(g, computeBounds(g));
+    Shader shader(scene);
+    const Vec3 p{0, 0.5, 0}, from{0, -3, 1.5};
+    const Vec3 col = shader.shade(Ray{from, normalize(p - from)});
+    const double k = 1 + 2.0 * 2.0;
+    EXPECT_NEAR(col.x, 0.5 + 0.5 / k, 1e-9);
+    EXPECT_NEAR(col.y, 1 / k, 1e-9);
+}
+
 }  // namespace
 }  // namespace pcsg::tracer
