@@ -1,6 +1,8 @@
 // The ray tree of shading.h: POV-Ray 3.7's TraceRay and the single-layer case of its
 // ComputeLightedTexture, with the transparency of transparency.h.
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "pigment.h"
 #include "shading.h"
@@ -130,6 +132,37 @@ Vec3 Shader::shadowFilter(const Vec3& p, const Vec3& l, double dist, const Inter
         ++rays_;
     }
     return filter;
+}
+
+// Which solids contain `at`: a probe ray from it meets their surfaces from inside (the
+// normal, outward from the solid hit, points along the ray) before it has entered them.
+// The first one left is the innermost. Only scenes with transparency need it.
+const Interiors& Shader::startInteriors(const Vec3& at) {
+    if (startKnown_ && at == startAt_) return startInside_;
+    startKnown_ = true;
+    startAt_ = at;
+    startInside_ = Interiors{};
+    if (!anyTransparent_) return startInside_;
+    const Vec3 d = normalize(Vec3{0.5773, 0.5774, 0.5775});  // away from the axes
+    std::vector<uint32_t> entered, left;
+    Vec3 origin = at;
+    SurfaceHit hit;
+    for (int k = 0; k < 100000; ++k) {
+        if (!tracer_.firstHit(origin, d, C::kMinIsectDepth, C::kMaxDistance, hit)) break;
+        const uint32_t mi = hit.material < g_.materials.size() ? hit.material : 0;
+        if (dot(hit.normal, d) > 0) {
+            const auto it = std::find(entered.rbegin(), entered.rend(), mi);
+            if (it != entered.rend())
+                entered.erase(std::next(it).base());
+            else
+                left.push_back(mi);
+        } else {
+            entered.push_back(mi);
+        }
+        origin = origin + d * hit.t;
+    }
+    for (auto it = left.rbegin(); it != left.rend(); ++it) startInside_.push(*it);
+    return startInside_;
 }
 
 }  // namespace pcsg::tracer

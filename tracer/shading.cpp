@@ -123,7 +123,7 @@ Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pi
 }
 
 Vec3 Shader::shade(const Ray& ray) {
-    return trace(TreeRay{ray.origin, ray.dir, 0, Interiors{}, 0}, 1.0, false);
+    return trace(TreeRay{ray.origin, ray.dir, 0, startInteriors(ray.origin), 0}, 1.0, false);
 }
 
 }  // namespace pcsg::tracer

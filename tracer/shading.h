@@ -121,6 +121,9 @@ class Shader {
     // What reaches p from a light at distance `dist` in direction l through the surfaces
     // between: white when nothing is in the way, black when an opaque surface is.
     Vec3 shadowFilter(const Vec3& p, const Vec3& l, double dist, const Interiors& inside);
+    // The interiors of the solids that contain point `at` (POV-Ray's InitRayContainerState
+    // for camera rays), innermost last; remembered for the last point asked about.
+    const Interiors& startInteriors(const Vec3& at);
 
     // The local colour of a surface point (ambient, diffuse, phong; no reflection), whose
     // pigment there has colour `pigment` and opacity `opacity` (1 - filter - transmit),
@@ -136,6 +139,9 @@ class Shader {
     Tracer tracer_;
     uint64_t rays_ = 0;
     bool anyTransparent_ = false;  // transparency.h: else shadow rays stop at any surface
+    bool startKnown_ = false;      // startInteriors' memory
+    Vec3 startAt_;
+    Interiors startInside_;
 };
 
 }  // namespace pcsg::tracer

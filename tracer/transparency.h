@@ -10,7 +10,9 @@
 //    channel.
 //  - A transmitted ray is traced when min(1, |grey(let through)|) > adc_bailout (grey: POV-Ray's
 //    0.297 r + 0.589 g + 0.114 b), with weight times the largest channel of what is let through.
-//  - The interior stack (Interiors): the interiors a ray is inside, innermost last. A
+//  - The interior stack (Interiors): the interiors a ray is inside, innermost last; camera
+//    rays start with those of the solids containing the camera (POV-Ray's
+//    InitRayContainerState; Shader::startInteriors finds them with a probe ray). A
 //    surface's interior is its material (so two overlapping objects of one material count as
 //    one; POV-Ray tells them apart, see docs/language.md section 10). Crossing a surface of
 //    interior I (POV-Ray's rules, nested objects count as outside their container):
