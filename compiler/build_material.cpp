@@ -21,17 +21,7 @@ constexpr std::string_view kMaterialTakes =
 constexpr std::string_view kFinishTakes =
     "ambient, diffuse, brilliance, phong, phong_size, specular, roughness, metallic, reflection, "
     "conserve_energy";
-constexpr std::string_view kInteriorTakes = "ior";
-
-// Items of section 10 that the language defines and the renderers do not have yet.
-constexpr std::array<std::string_view, 2> kInteriorLater = {"fade_distance", "fade_power"};
-
-template <size_t N>
-bool among(const std::array<std::string_view, N>& names, std::string_view n) {
-    for (std::string_view s : names)
-        if (s == n) return true;
-    return false;
-}
+constexpr std::string_view kInteriorTakes = "ior, fade_distance, fade_power, fade_color";
 
 bool isColourWord(std::string_view w) {
     return w == "color" || w == "colour" || w == "rgb" || w == "rgbf" || w == "rgbt" ||
@@ -81,6 +71,7 @@ class MaterialReader : public PatternValues {
     void reflectionBlock(Range r, const Atom& item);
     void normal(Range r);
     void interior(Range r);
+    bool interiorItem(Range& r, const Atom& item, std::string_view n);
     void checkPositive(const Atom& item, double v);
 
     BuildContext& ctx_;
@@ -248,9 +239,6 @@ void MaterialReader::setColour(const FilterColour& c) {
     m_.color = c.rgb;
     m_.filter = c.filter;
     m_.transmit = c.transmit;
-    if (c.filter != 0 || c.transmit != 0)
-        ctx_.error(colourTok_,
-                   "filter and transmit (transparency) are not implemented yet: they must be 0");
 }
 
 // The block `{ ... }` that follows `item`, or null (reported).
@@ -284,19 +272,42 @@ void MaterialReader::skipValues(Range& r) {
     while (!r.done() && peek(r).kind != AtomKind::Word) ++r.i;
 }
 
-// An item the block does not take: not implemented yet (section 10), or unknown.
+// An item the block does not take.
 void MaterialReader::reject(Range& r, const Atom& item, std::string_view block,
                             std::string_view takes) {
-    const std::string_view n = word(item);
-    const bool later = block == "interior" && among(kInteriorLater, n);
-    if (later)
-        ctx_.error(item.tok, fmt::format("'{}' in {} is not implemented yet ({} takes {})", clip(n),
-                                         block, block, takes));
-    else
-        ctx_.error(item.tok, fmt::format("unknown {} setting '{}' ({} takes {})", block, clip(n),
-                                         block, takes));
+    ctx_.error(item.tok, fmt::format("unknown {} setting '{}' ({} takes {})", block,
+                                     clip(word(item)), block, takes));
     skipValues(r);
     while (nextIs(r, AtomKind::Block) || nextIs(r, AtomKind::Bracket)) ++r.i;
+}
+
+// ior (greater than 0), and POV-Ray's fade_distance, fade_power (numbers, constants) and
+// fade_color (a colour's red, green and blue).
+bool MaterialReader::interiorItem(Range& r, const Atom& item, std::string_view n) {
+    if (n == "ior") {
+        if (auto v = number(r, item, 13)) {
+            checkPositive(item, *v);
+            m_.ior = *v;
+        }
+    } else if (n == "fade_distance" || n == "fade_power") {
+        if (auto v = number(r, item, kConstant))
+            (n == "fade_power" ? m_.fadePower : m_.fadeDistance) = *v;
+    } else if (n == "fade_color" || n == "fade_colour") {
+        if (nextIs(r, AtomKind::Word) && isColourWord(word(peek(r)))) {
+            const Atom& model = ast_.atoms[r.i++];
+            if (auto c = colour(r, model, kConstant)) m_.fadeColour = c->rgb;
+        } else if (nextIs(r, AtomKind::Vector)) {
+            if (auto c = colourComponents(item, ast_.atoms[r.i++], kConstant))
+                m_.fadeColour = c->rgb;
+        } else {
+            ctx_.error(item.tok, fmt::format("'{}' takes a colour", clip(n)));
+            skipValues(r);
+        }
+    } else {
+        return false;
+    }
+    m_.interior = true;
+    return true;
 }
 
 void MaterialReader::checkPositive(const Atom& item, double v) {
@@ -490,14 +501,7 @@ void MaterialReader::normal(Range r) {
 void MaterialReader::interior(Range r) {
     while (!r.done()) {
         const Atom& item = ast_.atoms[r.i++];
-        if (item.kind == AtomKind::Word && word(item) == "ior") {
-            if (auto v = number(r, item, 13)) {
-                checkPositive(item, *v);
-                m_.ior = *v;
-                m_.interior = true;
-            }
-            continue;
-        }
+        if (item.kind == AtomKind::Word && interiorItem(r, item, word(item))) continue;
         if (item.kind != AtomKind::Word) {
             ctx_.error(item.tok,
                        fmt::format("expected an interior item, found {}", describeAtom(item)));

@@ -20,6 +20,7 @@ class DirectiveReader {
         : ctx_(ctx), g_(ctx.g), ast_(ctx.ast), exprs_(exprs) {}
 
     void settings(const Stmt& s);
+    void traceSetting(std::string_view n, const DirectiveItem& item, Settings& st);
     void camera(const Stmt& s);
     void light(const Stmt& s);
     void background(const Stmt& s);
@@ -154,10 +155,12 @@ std::optional<double> DirectiveReader::wantScalar(const DirectiveItem& item, uin
     return value(item.e[0], field);
 }
 
+constexpr const char* kSettingsTakes = "seed, max_depth, max_trace_level, adc_bailout";
+
 void DirectiveReader::settings(const Stmt& s) {
     if (!once(settingsSeen_, s, "settings")) return;
     Settings& st = g_.scene.settings;
-    items(s, "settings", "seed, max_depth", [&](std::string_view n, const DirectiveItem& item) {
+    items(s, "settings", kSettingsTakes, [&](std::string_view n, const DirectiveItem& item) {
         if (n == "seed") {
             if (auto v = wantScalar(item, kSetting)) {
                 if (*v < 0 || *v != std::floor(*v) || *v > 9007199254740992.0)
@@ -177,11 +180,32 @@ void DirectiveReader::settings(const Stmt& s) {
                 else
                     st.maxDepth = static_cast<uint32_t>(*v);
             }
+        } else if (n == "max_trace_level" || n == "adc_bailout") {
+            traceSetting(n, item, st);
         } else {
             return false;
         }
         return true;
     });
+}
+
+// POV-Ray's max_trace_level (a whole number from 1 to 256, its limit) and adc_bailout (a
+// weight from 0 to 1).
+void DirectiveReader::traceSetting(std::string_view n, const DirectiveItem& item, Settings& st) {
+    const auto v = wantScalar(item, kSetting);
+    if (!v) return;
+    if (n == "max_trace_level") {
+        if (*v < 1 || *v != std::floor(*v) || *v > 256)
+            ctx_.error(
+                item.nameTok,
+                fmt::format("max_trace_level must be a whole number from 1 to 256, found {}", *v));
+        else
+            st.maxTraceLevel = static_cast<uint32_t>(*v);
+    } else if (*v < 0 || *v > 1) {
+        ctx_.error(item.nameTok, fmt::format("adc_bailout must be from 0 to 1, found {}", *v));
+    } else {
+        st.adcBailout = *v;
+    }
 }
 
 void DirectiveReader::camera(const Stmt& s) {

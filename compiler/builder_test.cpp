@@ -526,6 +526,38 @@ TEST(Directives, MaterialBlocks) {
     EXPECT_EQ(m[3].minReflection(), 0.4);
 }
 
+// Transparency (section 10): filter and transmit of the colour, the interior's fade items,
+// and the trace settings.
+TEST(Directives, TransparencyItems) {
+    auto c = compile(
+        "settings { max_trace_level 12  adc_bailout 0.02 }\n"
+        "material a { pigment { color rgbft <1, 0.5, 0.25, 0.6, 0.3> }\n"
+        "  interior { ior 1.33 fade_distance 4 fade_power 1001 fade_color rgb <0.5, 0.25, 0> } }\n"
+        "material b { color rgbt <0.2, 0.4, 0.6, 0.7>  interior { fade_color <1, 0, 0> } }\n"
+        "paint(a) sphere ∪ paint(b) cube\n");
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Settings& st = c->graph->scene.settings;
+    EXPECT_EQ(st.maxTraceLevel, 12u);
+    EXPECT_EQ(st.adcBailout, 0.02);
+    const auto& m = c->graph->materials;
+    ASSERT_EQ(m.size(), 3u);
+    EXPECT_EQ(m[1].filter, 0.6);
+    EXPECT_EQ(m[1].transmit, 0.3);
+    EXPECT_EQ(m[1].ior, 1.33);
+    EXPECT_EQ(m[1].fadeDistance, 4);
+    EXPECT_EQ(m[1].fadePower, 1001);
+    EXPECT_EQ(m[1].fadeColour, (Vec3{0.5, 0.25, 0}));
+    EXPECT_TRUE(m[1].interior);
+    EXPECT_EQ(m[2].filter, 0);
+    EXPECT_EQ(m[2].transmit, 0.7);
+    EXPECT_EQ(m[2].fadeColour, (Vec3{1, 0, 0}));
+    EXPECT_EQ(c->graph->scene.settings.maxTraceLevel, 12u);
+    auto d = compile("sphere");
+    ASSERT_TRUE(d->graph);
+    EXPECT_EQ(d->graph->scene.settings.maxTraceLevel, 5u);
+    EXPECT_EQ(d->graph->scene.settings.adcBailout, 1.0 / 255.0);
+}
+
 TEST(Directives, DefaultsWithoutAny) {
     auto c = compile("sphere");
     ASSERT_TRUE(c->graph) << c->errors();

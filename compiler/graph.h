@@ -277,8 +277,13 @@ struct Material {
     bool interior = false;  // an interior { } was given (the exporter writes it)
     double filter = 0;      // 14: the plain pigment colour's filter
     double transmit = 0;    // 15: and transmit
-    Pigment pigment{};      // its pattern (PatternKind::Plain: color, filter, transmit)
-    NormalSpec normal{};    // NormalKind::None: the surface's own normal
+    // interior { fade_distance fade_power fade_color } (constants): POV-Ray's attenuation of
+    // light travelling inside; fade_distance 0 is none.
+    double fadeDistance = 0;
+    double fadePower = 0;
+    Vec3 fadeColour{0, 0, 0};
+    Pigment pigment{};    // its pattern (PatternKind::Plain: color, filter, transmit)
+    NormalSpec normal{};  // NormalKind::None: the surface's own normal
 
     double minReflection() const { return reflectionRange ? reflectionMin : reflection; }
 };
@@ -287,6 +292,10 @@ inline constexpr uint8_t kMaterialFields = 16;
 struct Settings {
     uint64_t seed = 0;
     uint32_t maxDepth = 256;
+    // POV-Ray's global_settings: the deepest ray tree (the camera ray is level 1) and the
+    // weight below which a ray is not traced.
+    uint32_t maxTraceLevel = 5;
+    double adcBailout = 1.0 / 255.0;
 };
 
 struct Scene {

@@ -21,8 +21,8 @@ std::string vec(const Vec3& v) {
 std::string povLight(const Light& l) {
     std::string s = fmt::format("light_source {{ {} color rgb {}", vec(l.position), vec(l.color));
     if (l.spotlight)
-        s += fmt::format(" spotlight point_at {} radius {} falloff {} tightness {}",
-                         vec(l.pointAt), num(l.radius), num(l.falloff), num(l.tightness));
+        s += fmt::format(" spotlight point_at {} radius {} falloff {} tightness {}", vec(l.pointAt),
+                         num(l.radius), num(l.falloff), num(l.tightness));
     if (l.shadowless) s += " shadowless";
     if (l.fadePower > 0)
         s += fmt::format(" fade_distance {} fade_power {}", num(l.fadeDistance), num(l.fadePower));
@@ -38,12 +38,10 @@ std::string povLight(const Light& l) {
 
 std::string povFog(const Fog& f) {
     if (!f.enabled) return {};
-    std::string s =
-        fmt::format("fog {{ fog_type {} distance {} color rgbft <{},{},{},{},{}>", f.type,
-                    num(f.distance), num(f.color.x), num(f.color.y), num(f.color.z),
-                    num(f.filter), num(f.transmit));
-    if (f.type == 2)
-        s += fmt::format(" fog_offset {} fog_alt {} up z", num(f.offset), num(f.alt));
+    std::string s = fmt::format("fog {{ fog_type {} distance {} color rgbft <{},{},{},{},{}>",
+                                f.type, num(f.distance), num(f.color.x), num(f.color.y),
+                                num(f.color.z), num(f.filter), num(f.transmit));
+    if (f.type == 2) s += fmt::format(" fog_offset {} fog_alt {} up z", num(f.offset), num(f.alt));
     return s + " }";
 }
 

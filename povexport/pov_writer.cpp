@@ -259,6 +259,26 @@ void putTexture(Out& o, const Material& m) {
     o.raw(povNormal(m));
 }
 
+// interior { ior fade_distance fade_power fade_color } with the items that differ from
+// POV-Ray's defaults.
+void putInterior(Out& o, const Material& m) {
+    o.put(" interior {{ ior ");
+    o.num(m.ior);
+    if (m.fadeDistance != 0) {
+        o.put(" fade_distance ");
+        o.num(m.fadeDistance);
+    }
+    if (m.fadePower != 0) {
+        o.put(" fade_power ");
+        o.num(m.fadePower);
+    }
+    if (m.fadeColour != Vec3{0, 0, 0}) {
+        o.put(" fade_color rgb ");
+        o.vec(m.fadeColour);
+    }
+    o.put(" }}");
+}
+
 void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& opt) {
     o.put("// POV-Ray 3.7 scene exported by pcsg export-pov{}{}\n",
           opt.title.empty() ? "" : " from ", opt.title);
@@ -266,7 +286,13 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
     o.put("// render: povray +I<file> +W{} +H{} (the camera's aspect is {}:{})\n", opt.width,
           opt.height, opt.width, opt.height);
     o.put("#version 3.7;\n");
-    o.put("global_settings {{ assumed_gamma 1.0 max_trace_level 5 }}\n\n");
+    o.put("global_settings {{ assumed_gamma 1.0 max_trace_level {}",
+          g.scene.settings.maxTraceLevel);
+    if (g.scene.settings.adcBailout != 1.0 / 255.0) {
+        o.put(" adc_bailout ");
+        o.num(g.scene.settings.adcBailout);
+    }
+    o.put(" }}\n\n");
     o.put("{}\n", povCamera(g.scene.camera, opt.width, opt.height));
     for (const Light& l : g.scene.lights) o.put("{}\n", povLight(l));
     if (g.scene.fog.enabled) o.put("{}\n", povFog(g.scene.fog));
@@ -282,11 +308,7 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
         o.put("#declare M{} = {}", i, wrapped ? "material { texture { " : "texture { ");
         putTexture(o, m);
         o.put(" }}");
-        if (wrapped && m.interior) {
-            o.put(" interior {{ ior ");
-            o.num(m.ior);
-            o.put(" }}");
-        }
+        if (wrapped && m.interior) putInterior(o, m);
         if (wrapped) o.put(" }}");
         if (!m.name.empty()) o.put("  // {}", commentSafe(m.name));
         o.put("\n");

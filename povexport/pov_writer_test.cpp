@@ -148,6 +148,37 @@ TEST(PovWriter, FinishItemsAndInteriors) {
     EXPECT_EQ(occurrences(s, "texture{M"), 0u);
 }
 
+// Transparency: a colour with filter and transmit is written as rgbft, the interior's fade
+// items where they are not POV-Ray's defaults, and the settings' max_trace_level and
+// adc_bailout in global_settings.
+TEST(PovWriter, FilterTransmitFadeAndTraceLevel) {
+    Graph g;
+    defaultScene(g);
+    g.scene.settings.maxTraceLevel = 9;
+    g.scene.settings.adcBailout = 0.01;
+    Material glass;
+    glass.color = {0.5, 1, 0.25};
+    glass.filter = 0.75;
+    glass.transmit = 0.125;
+    glass.interior = true;
+    glass.ior = 1.33;
+    glass.fadeDistance = 2;
+    glass.fadePower = 1001;
+    glass.fadeColour = {0.5, 0, 0};
+    g.materials.push_back(glass);
+    g.axiom = paint(g, 1, primitive(g, P::Sphere));
+    const std::string s = exportText(g);
+    EXPECT_NE(s.find("global_settings { assumed_gamma 1.0 max_trace_level 9 adc_bailout 0.01 }"),
+              std::string::npos)
+        << s;
+    EXPECT_NE(s.find("pigment { color rgbft <0.5,1,0.25,0.75,0.125> }"), std::string::npos)
+        << s;
+    EXPECT_NE(s.find("interior { ior 1.33 fade_distance 2 fade_power 1001 fade_color rgb "
+                     "<0.5,0,0> } }"),
+              std::string::npos)
+        << s;
+}
+
 // A paint node's material is one texture where the paint stands (docs/language.md
 // section 10): on the union it paints, not copied onto each primitive. An inner paint is
 // a texture of its own, which POV-Ray keeps (inner textures override outer), and the root

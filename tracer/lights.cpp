@@ -33,8 +33,8 @@ double cubicSpline(double low, double high, double pos) {
 // A fixed number in [0, 1) for a lit point and a grid index: `jitter` without a random
 // generator, so that renders are reproducible (and agree between threads and processes).
 double jitterHash(const Vec3& p, int u, int v, int axis) {
-    uint64_t h = 0x9e3779b97f4a7c15ull * static_cast<uint64_t>(u * 1315423911u + v * 2654435761u +
-                                                               axis * 97u + 1);
+    uint64_t h = 0x9e3779b97f4a7c15ull *
+                 static_cast<uint64_t>(u * 1315423911u + v * 2654435761u + axis * 97u + 1);
     for (double c : {p.x, p.y, p.z}) {
         uint64_t bits;
         std::memcpy(&bits, &c, sizeof bits);
@@ -82,8 +82,8 @@ class AreaRecursion {
 
   private:
     Vec3 at(int u, int v) {
-        const size_t k = static_cast<size_t>(u) * static_cast<size_t>(size2_) +
-                         static_cast<size_t>(v);
+        const size_t k =
+            static_cast<size_t>(u) * static_cast<size_t>(size2_) + static_cast<size_t>(v);
         if (!done_[k]) {
             grid_[k] = sample_(u, v);
             done_[k] = 1;
@@ -99,7 +99,7 @@ class AreaRecursion {
 
 // The shadow of an area light at p: the light's colour where a grid point is visible.
 Vec3 areaShadow(const Light& light, const Vec3& p, const Vec3& colour, const Vec3& toCentre,
-                Tracer& tracer, uint64_t& rays) {
+                ShadowRays& shadows) {
     Vec3 axis1 = light.axis1, axis2 = light.axis2;
     if (light.orient) orientAxes(light, toCentre, axis1, axis2);
     const AreaSample sample = [&](int u, int v) {
@@ -111,9 +111,7 @@ Vec3 areaShadow(const Light& light, const Vec3& p, const Vec3& colour, const Vec
         const Vec3 l = light.position + areaOffset(light, ju, jv, axis1, axis2) - p;
         const double d = length(l);
         if (!(d > 0)) return colour;
-        ++rays;
-        return tracer.anyHit(p, l / d, kShadowTolerance, d - kShadowTolerance) ? Vec3{0, 0, 0}
-                                                                               : colour;
+        return mul(colour, shadows.filter(p, l / d, d));
     };
     return areaAverage(light.size1, light.size2, light.adaptive, sample);
 }
@@ -169,8 +167,8 @@ void orientAxes(const Light& light, const Vec3& l, Vec3& axis1, Vec3& axis2) {
     axis1 = axis1 * len;
 }
 
-bool lightArriving(const Light& light, const Vec3& p, const Vec3& n, Tracer& tracer,
-                   uint64_t& rays, ArrivingLight& out) {
+bool lightArriving(const Light& light, const Vec3& p, const Vec3& n, ShadowRays& shadows,
+                   ArrivingLight& out) {
     Vec3 l = light.position - p;
     const double d = length(l);
     if (!(d > 0)) return false;
@@ -182,10 +180,9 @@ bool lightArriving(const Light& light, const Vec3& p, const Vec3& n, Tracer& tra
     if (dot(n, l) < kEpsilon) return false;  // the light is behind the surface
     if (!light.shadowless) {
         if (light.areaLight()) {
-            colour = areaShadow(light, p, colour, l, tracer, rays);
+            colour = areaShadow(light, p, colour, l, shadows);
         } else {
-            ++rays;
-            if (tracer.anyHit(p, l, kShadowTolerance, d - kShadowTolerance)) return false;
+            colour = mul(colour, shadows.filter(p, l, d));
         }
         if (nearZero(colour)) return false;
     }

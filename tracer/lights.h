@@ -60,12 +60,23 @@ void orientAxes(const Light& light, const Vec3& l, Vec3& axis1, Vec3& axis2);
 // The light arriving at p with normal n (facing the viewer): its direction (unit, toward
 // the light's centre) and its colour after attenuation and shadows. False when none
 // arrives. `rays` counts the shadow rays.
+// The light that gets from a point to a light point at distance `dist` along the unit
+// direction l: 1 where nothing is in the way, 0 behind an opaque surface, tinted by the
+// transparent surfaces on the way (the shader's filtered shadow rays, ray_tree.cpp).
+class ShadowRays {
+  public:
+    virtual Vec3 filter(const Vec3& from, const Vec3& l, double dist) = 0;
+
+  protected:
+    ~ShadowRays() = default;
+};
+
 struct ArrivingLight {
     Vec3 dir{0, 0, 0};
     Vec3 colour{0, 0, 0};
     bool highlights = true;  // false for shadowless lights
 };
-bool lightArriving(const Light& light, const Vec3& p, const Vec3& n, Tracer& tracer,
-                   uint64_t& rays, ArrivingLight& out);
+bool lightArriving(const Light& light, const Vec3& p, const Vec3& n, ShadowRays& shadows,
+                   ArrivingLight& out);
 
 }  // namespace pcsg::tracer

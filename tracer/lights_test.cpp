@@ -39,7 +39,7 @@ Vec3 toLight(double a) {
 TEST(Lights, SpotlightConeRadiusFalloffAndTightness) {
     const Light l = spot(10, 30, 0);
     EXPECT_DOUBLE_EQ(spotAttenuation(l, toLight(0)), 1.0);
-    EXPECT_DOUBLE_EQ(spotAttenuation(l, toLight(9.9)), 1.0);  // inside the radius
+    EXPECT_DOUBLE_EQ(spotAttenuation(l, toLight(9.9)), 1.0);   // inside the radius
     EXPECT_DOUBLE_EQ(spotAttenuation(l, toLight(30.5)), 0.0);  // beyond the falloff
     EXPECT_DOUBLE_EQ(spotAttenuation(l, toLight(95)), 0.0);    // behind the light
     // Between: the cubic spline of the cosines.
@@ -66,7 +66,7 @@ TEST(Lights, FadingWithDistance) {
     EXPECT_DOUBLE_EQ(fadeAttenuation(l, 4), 1.0);  // 2 / (1 + 1)
     EXPECT_DOUBLE_EQ(fadeAttenuation(l, 8), 2.0 / 5.0);
     EXPECT_DOUBLE_EQ(fadeAttenuation(l, 2), 2.0 / 1.25);  // brighter than the colour nearby
-    l.fadeDistance = 0;  // POV-Ray's d^-fade_power
+    l.fadeDistance = 0;                                   // POV-Ray's d^-fade_power
     EXPECT_DOUBLE_EQ(fadeAttenuation(l, 4), 1.0 / 16.0);
 }
 

@@ -13,7 +13,8 @@ namespace pcsg::tracer {
 
 using C = ShadingConstants;
 
-Shader::Shader(const TraceScene& scene) : g_(scene.graph()), tracer_(scene) {}
+Shader::Shader(const TraceScene& scene)
+    : g_(scene.graph()), tracer_(scene), anyTransparent_(anyTransparent(scene.graph())) {}
 
 namespace {
 
@@ -39,13 +40,13 @@ Vec3 highlight(double intensity, const Vec3& lightColour, const Material& m, con
 
 // Diffuse, phong and specular of one light seen along direction l (unit, toward the light).
 Vec3 Shader::lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
-                 const Material& m, const Vec3& pigment, bool highlights) const {
+                 const Material& m, const Vec3& pigment, double opacity, bool highlights) const {
     Vec3 colour{0, 0, 0};
     const double cosAngle = dot(n, l);
     if (m.diffuse > 0) {
         const double c = std::fabs(cosAngle);
         const double intensity = m.brilliance != 1 ? std::pow(c, m.brilliance) : c;
-        colour += mul(lightColour, pigment) * (intensity * m.diffuse);
+        colour += mul(lightColour, pigment) * (intensity * m.diffuse * opacity);
     }
     if (!highlights) return colour;
     if (m.phong > 0) {
@@ -71,26 +72,35 @@ Vec3 Shader::lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightC
 }
 
 Vec3 Shader::local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m,
-                   const Vec3& pigment) {
-    Vec3 colour = pigment * (m.ambient * C::kAmbientLight);
+                   const Vec3& pigment, double opacity, const Interiors& inside) {
+    Vec3 colour = pigment * (m.ambient * C::kAmbientLight * opacity);
     if (!(m.diffuse != 0 || m.phong != 0 || m.specular != 0)) return colour;
+    // Shadow rays filtered by the transparent surfaces they pass (ray_tree.cpp).
+    struct Filtered final : ShadowRays {
+        Shader& shader;
+        const Interiors& inside;
+        Filtered(Shader& s, const Interiors& i) : shader(s), inside(i) {}
+        Vec3 filter(const Vec3& from, const Vec3& l, double dist) override {
+            return shader.shadowFilter(from, l, dist, inside);
+        }
+    } shadows(*this, inside);
     for (const Light& light : g_.scene.lights) {
         ArrivingLight a;  // lights.h: spot, fade, area and shadowless lights
-        if (lightArriving(light, p, n, tracer_, rays_, a))
-            colour += lit(n, d, a.dir, a.colour, m, pigment, a.highlights);
+        if (lightArriving(light, p, n, shadows, a))
+            colour += lit(n, d, a.dir, a.colour, m, pigment, opacity, a.highlights);
     }
     return colour;
 }
 
-Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pigment) {
+Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pigment,
+                          double relativeIor) {
     const double hi = m.reflection, lo = m.minReflection();
     Reflectivity out;
     double amount;
     if (m.fresnel) {
-        // POV-Ray's Fresnel formula for unpolarised light; the ray comes from the
-        // atmosphere (ior 1), so the relative ior is the interior's.
+        // POV-Ray's Fresnel formula for unpolarised light at the relative ior.
         const double c = cosIncidence;
-        const double sqx = m.ior * m.ior + c * c - 1;
+        const double sqx = relativeIor * relativeIor + c * c - 1;
         if (sqx > 0) {
             const double g = std::sqrt(sqx);
             double f = 0.5 * ((g - c) * (g - c)) / ((g + c) * (g + c));
@@ -121,40 +131,7 @@ Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pi
 }
 
 Vec3 Shader::shade(const Ray& ray) {
-    Vec3 colour{0, 0, 0};
-    Vec3 origin = ray.origin, dir = ray.dir;
-    double weight = 1.0;         // POV-Ray's ray weight, for adc_bailout
-    Vec3 factor{1.0, 1.0, 1.0};  // the product of the reflectivities so far
-    for (int level = 1; level <= C::kMaxTraceLevel; ++level) {
-        ++rays_;
-        SurfaceHit hit;
-        const bool found = tracer_.firstHit(origin, dir, C::kMinIsectDepth, C::kMaxDistance, hit);
-        if (g_.scene.fog.enabled) {  // fog.h: colour = add + attenuation x the colour behind
-            const FogEffect f = fogAlong(g_.scene.fog, origin, dir, found ? hit.t : kFogMissDepth);
-            colour += mul(f.add, factor);
-            factor = mul(factor, f.attenuation);
-        }
-        if (!found) {
-            colour += mul(g_.scene.background, factor);
-            break;
-        }
-        const Vec3 p = origin + dir * hit.t;
-        Vec3 n = normalize(hit.normal);
-        if (!isFinite(n)) n = -dir;  // degenerate normal (apex of a cone): face the viewer
-        if (dot(n, dir) > 0) n = -n;
-        const Material& m = g_.materials[hit.material < g_.materials.size() ? hit.material : 0];
-        if (m.normal.kind != NormalKind::None && hit.painted) n = perturbedNormal(m.normal, hit, n);
-        const FilterColour pigment = pigmentColour(m, hit);
-        colour += mul(local(p, n, dir, m, pigment.rgb), factor);
-        const Reflectivity r = reflectivity(m, -dot(dir, n), pigment.rgb);
-        if (r.colour.x == 0 && r.colour.y == 0 && r.colour.z == 0) break;
-        weight *= r.weight;
-        if (weight < C::kAdcBailout) break;
-        factor = mul(factor, r.colour);
-        dir = normalize(dir - n * (2 * dot(dir, n)));
-        origin = p;
-    }
-    return colour;
+    return trace(TreeRay{ray.origin, ray.dir, 0, startInteriors(ray.origin), 0}, 1.0, false);
 }
 
 }  // namespace pcsg::tracer

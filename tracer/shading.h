@@ -37,18 +37,21 @@
 //      * without fresnel, amount = min when 1 - cos is 0, max when it is 1, else (1 - cos)
 //        max + cos min; the ray's weight is multiplied by max(min, max);
 //      * with fresnel, f = POV-Ray's Fresnel formula for unpolarised light at the relative
-//        ior (the interior's: the ray comes from the atmosphere), amount = f max + (1 - f)
+//        ior (n2 / n1 by the ray's interior stack, transparency.h), amount = f max + (1 - f)
 //        min (max when the square root's argument is not positive); the weight is
 //        multiplied by the amount;
 //      * `reflection { ... metallic k }` tints the amount by 1 + k (1 - F) (pigment - 1),
 //        F as above of acos(cos);
 //      * the colour gets + amount * colour(reflected ray), the reflected ray starting at P
-//        in direction D - 2 (D . N) N. A ray whose weight drops below adc_bailout (1/255) is
-//        not traced, and neither is a ray beyond max_trace_level (5: the camera ray and at
-//        most four reflections). Since reflection is linear, the tracer follows the chain of
-//        reflections in a loop.
-//  - conserve_energy changes only the light an object transmits, so nothing while there is
-//    no transparency.
+//        in direction D - 2 (D . N) N, inside the same interiors as the incoming ray.
+//  - The ray tree (ray_tree.cpp, POV-Ray's TraceRay): every surface may spawn a reflected
+//    and a transmitted ray (transparency.h has filter, transmit, refraction, fade and
+//    filtered shadows). A ray whose weight is below adc_bailout (settings, default 1/255)
+//    or whose parent is at max_trace_level (settings, default 5: the camera ray is level 1)
+//    is black; a ray continued straight through a surface between equal iors keeps its
+//    parent's level (POV-Ray's continued ray), and beyond 512 such rays on one path of the
+//    tree is black too (a bound on the recursion that POV-Ray does not have; only rays
+//    through hundreds of fully transparent walls reach it).
 //  - Materials: POV-Ray's defaults for items left out (graph.h's Material), colour <1,1,1>
 //    for the default material.
 //  - Output: linear colours; images are encoded as sRGB (render.h) as POV-Ray 3.7 does with
@@ -59,6 +62,7 @@
 
 #include "camera.h"
 #include "graph.h"
+#include "transparency.h"
 #include "traversal.h"
 
 namespace pcsg::tracer {
@@ -79,7 +83,13 @@ struct Reflectivity {
     Vec3 colour{0, 0, 0};
     double weight = 0;
 };
-Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pigment);
+// `relativeIor`: n2 / n1 at the surface, which fresnel reflection reads.
+Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pigment,
+                          double relativeIor);
+// A ray coming from the atmosphere (relative ior: the material's).
+inline Reflectivity reflectivity(const Material& m, double cosIncidence, const Vec3& pigment) {
+    return reflectivity(m, cosIncidence, pigment, m.ior);
+}
 
 // The colour seen along one ray, per thread (it owns a Tracer).
 class Shader {
@@ -89,22 +99,53 @@ class Shader {
     // The linear RGB colour of a camera ray (world space, unit direction).
     Vec3 shade(const Ray& ray);
 
-    // Rays traced so far: camera, shadow and reflection rays.
+    // Rays traced so far: camera, shadow, reflected and transmitted rays.
     uint64_t rays() const { return rays_; }
     uint64_t nodeVisits() const { return tracer_.nodeVisits(); }
     Tracer& tracer() { return tracer_; }
 
   private:
+    // A ray of the tree (ray_tree.cpp): unit direction, POV-Ray's trace level of its parent
+    // (the camera ray: 0) and the interiors it travels in.
+    struct TreeRay {
+        Vec3 origin, dir;
+        int level = 0;
+        Interiors inside;
+        int straight = 0;  // rays continued straight on along its path (at most kMaxStraight)
+    };
+    // A bound on the C++ recursion of rays continued straight through surfaces (which do
+    // not count trace levels): past it a ray is black, as one past max_trace_level.
+    static constexpr int kMaxStraight = 512;
+    struct Surface;  // a hit being shaded (ray_tree.cpp)
+    Vec3 trace(const TreeRay& ray, double weight, bool continued);
+    Vec3 shadeHit(const TreeRay& ray, const SurfaceHit& hit, double weight, bool continued);
+    Vec3 shadeSurface(const Surface& s, double weight);
+    Vec3 transmitted(const Surface& s, double weight, bool& totalReflection);
+    Vec3 reflected(const Surface& s, double weight);
+    // What reaches p from a light at distance `dist` in direction l through the surfaces
+    // between: white when nothing is in the way, black when an opaque surface is.
+    Vec3 shadowFilter(const Vec3& p, const Vec3& l, double dist, const Interiors& inside);
+    // The interiors of the solids that contain point `at` (POV-Ray's InitRayContainerState
+    // for camera rays), innermost last; remembered for the last point asked about.
+    const Interiors& startInteriors(const Vec3& at);
+
     // The local colour of a surface point (ambient, diffuse, phong; no reflection), whose
-    // pigment there has colour `pigment`.
-    Vec3 local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m, const Vec3& pigment);
-    // Diffuse, phong and specular of one unshadowed light in direction l.
+    // pigment there has colour `pigment` and opacity `opacity` (1 - filter - transmit),
+    // seen by a ray inside `inside`.
+    Vec3 local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m, const Vec3& pigment,
+               double opacity, const Interiors& inside);
+    // Diffuse, phong and specular of one light in direction l, of colour lightColour where
+    // it arrives.
     Vec3 lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
-             const Material& m, const Vec3& pigment, bool highlights = true) const;
+             const Material& m, const Vec3& pigment, double opacity, bool highlights = true) const;
 
     const Graph& g_;
     Tracer tracer_;
     uint64_t rays_ = 0;
+    bool anyTransparent_ = false;  // transparency.h: else shadow rays stop at any surface
+    bool startKnown_ = false;      // startInteriors' memory
+    Vec3 startAt_;
+    Interiors startInside_;
 };
 
 }  // namespace pcsg::tracer
