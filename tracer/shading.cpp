@@ -131,7 +131,7 @@ Vec3 Shader::shade(const Ray& ray) {
         ++rays_;
         SurfaceHit hit;
         if (!tracer_.firstHit(origin, dir, C::kMinIsectDepth, C::kMaxDistance, hit)) {
-            colour += mul(g_.scene.background, factor);
+            colour += mul(skyColour(g_.scene, dir), factor);
             break;
         }
         const Vec3 p = origin + dir * hit.t;
