@@ -94,7 +94,7 @@ struct LatticeAxis {
     double s;     // smoothstep weight of the upper plane
 };
 
-LatticeAxis latticeAxis(double x) {
+[[gnu::always_inline]] inline LatticeAxis latticeAxis(double x) {
     const int t = x >= 0 ? truncateToInt(x) : truncateToInt(x - (1 - kEpsilon));
     LatticeAxis a;
     a.index = static_cast<int>((static_cast<unsigned>(t) - static_cast<unsigned>(kMinCoordinate)) &
@@ -112,7 +112,7 @@ struct Cell {
     int ixiy, jxiy, ixjy, jxjy;  // Hash2d of the four (x, y) corners
 };
 
-Cell cellOf(const Vec3& p, const NoiseTables& t) {
+[[gnu::always_inline]] inline Cell cellOf(const Vec3& p, const NoiseTables& t) {
     Cell c;
     c.x = latticeAxis(p.x);
     c.y = latticeAxis(p.y);

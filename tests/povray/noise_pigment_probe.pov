@@ -47,7 +47,7 @@ sphere { <1.9, -0.2, 0.5>, 0.5
   texture { pigment { bozo scale 0.3 } finish { diffuse 0.7 } }
 }
 sphere { <-0.6, -1.5, 0.45>, 0.45
-  texture { pigment { spotted turbulence 0.5 octaves 3 omega 0.7 lambda 2.5 scale 0.4 }
+  texture { pigment { spotted turbulence 1.2 octaves 3 omega 0.7 lambda 2.5 scale 0.4 }
             finish { diffuse 0.7 } }
 }
 torus { 0.45, 0.2 rotate x * 90 translate <0.7, -1.5, 0.25>

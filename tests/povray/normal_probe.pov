@@ -27,27 +27,27 @@ background { color rgb <0.25, 0.35, 0.55> }
 
 plane { z, 0
   texture { pigment { color rgb <0.6, 0.6, 0.65> }
-            normal { bumps 0.4 scale 0.3 }
+            normal { bumps 1.2 scale 0.3 }
             finish { ambient 0.1 diffuse 0.7 } }
 }
 sphere { <-1.6, 0, 0.7>, 0.7
   texture { pigment { color rgb <0.8, 0.35, 0.25> }
-            normal { dents 0.9 scale 0.25 }
+            normal { dents 3 scale 0.25 }
             finish { diffuse 0.7 phong 0.6 phong_size 40 } }
 }
 sphere { <0, 0.6, 0.8>, 0.8
   texture { pigment { color rgb <0.85, 0.75, 0.4> }
-            normal { wrinkles 0.7 scale 0.3 turbulence 0.3 }
+            normal { wrinkles 1.2 scale 0.3 turbulence 0.3 }
             finish { diffuse 0.7 specular 0.5 roughness 0.02 } }
 }
 sphere { <0, 0, 0>, 0.7
   texture { pigment { color rgb <0.3, 0.5, 0.8> }
-            normal { ripples 0.6 frequency 6 }
+            normal { ripples 1 frequency 6 }
             finish { diffuse 0.6 phong 0.8 phong_size 60 } }
   translate <1.7, 0, 0.7>
 }
 torus { 0.6, 0.25 rotate x * 90 translate <0, -1.6, 0.3>
   texture { pigment { color rgb <0.5, 0.8, 0.5> }
-            normal { waves 0.5 frequency 4 phase 0.2 scale <0.5, 1, 1> rotate <0, 0, 30> }
+            normal { waves 1 frequency 4 phase 0.2 scale <0.5, 1, 1> rotate <0, 0, 30> }
             finish { diffuse 0.7 phong 0.5 phong_size 30 } }
 }
