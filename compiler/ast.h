@@ -92,10 +92,14 @@ enum class StmtKind : uint8_t {
 };
 
 // One `name value` item of a directive; `background <...>` is one item with name the
-// keyword itself. A vector has three components, a scalar one.
+// keyword itself. A vector has three components, a scalar one. A name alone (`spotlight`)
+// is a flag. Values after a comma (`area_light <a1>, <a2>, 4, 4`) are the `more` items that
+// follow this one in Ast::items, each with the same name token.
 struct DirectiveItem {
     uint32_t nameTok;
     bool vector = false;
+    bool flag = false;
+    uint8_t more = 0;
     uint32_t e[3] = {kNoNode, kNoNode, kNoNode};
 };
 

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "build_material.h"
@@ -22,6 +23,7 @@ class DirectiveReader {
     void camera(const Stmt& s);
     void light(const Stmt& s);
     void background(const Stmt& s);
+    void fog(const Stmt& s);
     void skySphere(const Stmt& s) {
         if (once(skySeen_, s, "sky_sphere")) readSkySphere(ctx_, exprs_, s);
     }
@@ -34,6 +36,17 @@ class DirectiveReader {
     std::optional<Vec3> vectorValue(const DirectiveItem& item, uint8_t field);
     std::optional<Vec3> wantVector(const DirectiveItem& item, uint8_t field);
     std::optional<double> wantScalar(const DirectiveItem& item, uint8_t field);
+    bool oneValue(const DirectiveItem& item);
+    bool flag(const DirectiveItem& item);
+    bool lightItem(Light& l, std::string_view n, const DirectiveItem& item);
+    bool spotItem(Light& l, std::string_view n, const DirectiveItem& item);
+    bool areaItem(Light& l, std::string_view n, const DirectiveItem& item);
+    void areaLight(Light& l, const DirectiveItem& item);
+    std::optional<double> wantNumber(const DirectiveItem& item, uint8_t field, double lo,
+                                     const char* rule, double hi = 1e300);
+    void checkLight(const Stmt& s, const Light& l, const std::vector<std::string_view>& given);
+    bool fogItem(Fog& f, std::string_view n, const DirectiveItem& item);
+    std::optional<double> constValue(uint32_t e, const char* what);
     void checkCamera(const Stmt& s);
     // Where the values read next go, should they read the time (TimedValue).
     void target(DirectiveTarget t, uint32_t index = 0) {
@@ -46,7 +59,7 @@ class DirectiveReader {
     const Ast& ast_;
     ExprCompiler& exprs_;
     uint32_t settingsSeen_ = kNoNode, cameraSeen_ = kNoNode, backgroundSeen_ = kNoNode,
-             skySeen_ = kNoNode;
+             fogSeen_ = kNoNode, skySeen_ = kNoNode;
     DirectiveTarget target_ = DirectiveTarget::Camera;
     uint32_t index_ = 0;
     bool timed_ = false;  // the last value read reads the time
@@ -70,7 +83,7 @@ bool DirectiveReader::once(uint32_t& seen, const Stmt& s, const char* what) {
 // unknown name.
 template <class F>
 void DirectiveReader::items(const Stmt& s, const char* what, const char* known, F set) {
-    for (uint32_t i = 0; i < s.count; ++i) {
+    for (uint32_t i = 0; i < s.count; i += 1 + ast_.items[s.first + i].more) {
         const DirectiveItem& item = ast_.items[s.first + i];
         if (!set(ctx_.text(item.nameTok), item))
             ctx_.error(item.nameTok, fmt::format("unknown {} setting '{}' ({} takes {})", what,
@@ -106,7 +119,26 @@ std::optional<Vec3> DirectiveReader::vectorValue(const DirectiveItem& item, uint
     return v;
 }
 
+// Whether an item has exactly one value; reports a flag without one, or several.
+bool DirectiveReader::oneValue(const DirectiveItem& item) {
+    if (item.flag)
+        ctx_.error(item.nameTok, fmt::format("'{}' needs a value", clip(ctx_.text(item.nameTok))));
+    else if (item.more > 0)
+        ctx_.error(item.nameTok, fmt::format("'{}' takes one value, found {}",
+                                             clip(ctx_.text(item.nameTok)), item.more + 1));
+    return !item.flag && item.more == 0;
+}
+
+// Whether a flag item (`spotlight`) stands alone; reports a value after it.
+bool DirectiveReader::flag(const DirectiveItem& item) {
+    if (!item.flag)
+        ctx_.error(item.nameTok, fmt::format("'{}' takes no value",
+                                             clip(ctx_.text(item.nameTok))));
+    return item.flag;
+}
+
 std::optional<Vec3> DirectiveReader::wantVector(const DirectiveItem& item, uint8_t field) {
+    if (!oneValue(item)) return std::nullopt;
     if (!item.vector) {
         ctx_.error(item.nameTok,
                    fmt::format("'{}' takes a vector '<x, y, z>'", clip(ctx_.text(item.nameTok))));
@@ -116,6 +148,7 @@ std::optional<Vec3> DirectiveReader::wantVector(const DirectiveItem& item, uint8
 }
 
 std::optional<double> DirectiveReader::wantScalar(const DirectiveItem& item, uint8_t field) {
+    if (!oneValue(item)) return std::nullopt;
     if (item.vector) {
         ctx_.error(item.nameTok,
                    fmt::format("'{}' takes a number, not a vector", clip(ctx_.text(item.nameTok))));
@@ -201,26 +234,230 @@ void DirectiveReader::checkCamera(const Stmt& s) {
         ctx_.error(s.tok, "the camera's sky vector is zero or parallel to its viewing direction");
 }
 
+// A number that must be at least `lo` (a value that reads the time is checked per frame
+// by nothing: POV-Ray's formulas take any number there).
+std::optional<double> DirectiveReader::wantNumber(const DirectiveItem& item, uint8_t field,
+                                                  double lo, const char* rule, double hi) {
+    const auto v = wantScalar(item, field);
+    if (v && !timed_ && !(*v >= lo && *v <= hi)) {
+        ctx_.error(item.nameTok, fmt::format("'{}' must be {}, found {}",
+                                             clip(ctx_.text(item.nameTok)), rule, *v));
+        return std::nullopt;
+    }
+    return v;
+}
+
+// A value that must be a constant, also where the directive's others may read the time.
+std::optional<double> DirectiveReader::constValue(uint32_t e, const char* what) {
+    const auto v = exprs_.directiveValue(e);
+    if (!v) return std::nullopt;
+    if (v->timed != kNone) {
+        ctx_.error(ast_.exprs[e].from,
+                   fmt::format("'{}' reads the time (clock, frame): {} are constants",
+                               g_.exprs[v->timed].text, what));
+        return std::nullopt;
+    }
+    return v->value;
+}
+
+// area_light <axis1>, <axis2>, size1, size2: two vectors, then two whole numbers >= 1.
+void DirectiveReader::areaLight(Light& l, const DirectiveItem& item) {
+    const DirectiveItem* v = &item;
+    if (item.flag || item.more != 3 || !v[0].vector || !v[1].vector || v[2].vector ||
+        v[3].vector) {
+        ctx_.error(item.nameTok, "'area_light' takes <axis1>, <axis2>, size1, size2 (two "
+                                 "vectors and two whole numbers)");
+        return;
+    }
+    Vec3 axes[2];
+    for (int a = 0; a < 2; ++a)
+        for (int i = 0; i < 3; ++i)
+            if (auto c = constValue(v[a].e[i], "area_light's values")) axes[a][i] = *c;
+    int sizes[2] = {1, 1};
+    for (int a = 0; a < 2; ++a) {
+        const auto n = constValue(v[2 + a].e[0], "area_light's values");
+        if (!n) continue;
+        if (!(*n >= 1 && *n <= 1000 && *n == std::floor(*n)))
+            ctx_.error(item.nameTok, fmt::format("area_light's size{} must be a whole number "
+                                                 "from 1 to 1000, found {}",
+                                                 a + 1, *n));
+        else
+            sizes[a] = static_cast<int>(*n);
+    }
+    l.axis1 = axes[0];
+    l.axis2 = axes[1];
+    l.size1 = sizes[0];
+    l.size2 = sizes[1];
+}
+
+bool DirectiveReader::spotItem(Light& l, std::string_view n, const DirectiveItem& item) {
+    std::optional<double> v;
+    if (n == "spotlight") {
+        l.spotlight = flag(item);
+    } else if (n == "point_at") {
+        if (auto p = wantVector(item, 6)) l.pointAt = *p;
+    } else if (n == "radius") {
+        if ((v = wantNumber(item, 11, 0, "from 0 to 90 degrees", 90))) l.radius = *v;
+    } else if (n == "falloff") {
+        if ((v = wantNumber(item, 12, 0, "from 0 to 90 degrees", 90))) l.falloff = *v;
+    } else if (n == "tightness") {
+        if ((v = wantNumber(item, 13, 0, "0 or more"))) l.tightness = *v;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+bool DirectiveReader::areaItem(Light& l, std::string_view n, const DirectiveItem& item) {
+    if (n == "area_light") {
+        areaLight(l, item);
+    } else if (n == "adaptive") {
+        if (oneValue(item) && !item.vector) {
+            const auto a = constValue(item.e[0], "adaptive's values");
+            if (a && !(*a >= 0 && *a <= 100 && *a == std::floor(*a)))
+                ctx_.error(item.nameTok,
+                           fmt::format("'adaptive' must be a whole number from 0 to 100, "
+                                       "found {}",
+                                       *a));
+            else if (a)
+                l.adaptive = static_cast<int>(*a);
+        } else if (!item.flag && item.more == 0) {
+            ctx_.error(item.nameTok, "'adaptive' takes a number, not a vector");
+        }
+    } else if (n == "jitter") {
+        l.jitter = flag(item);
+    } else if (n == "circular") {
+        l.circular = flag(item);
+    } else if (n == "orient") {
+        l.orient = flag(item);
+    } else {
+        return false;
+    }
+    return true;
+}
+
+bool DirectiveReader::lightItem(Light& l, std::string_view n, const DirectiveItem& item) {
+    std::optional<double> v;
+    if (n == "position") {
+        if (auto p = wantVector(item, 0)) l.position = *p;
+    } else if (n == "color" || n == "colour") {
+        if (auto c = wantVector(item, 3)) l.color = *c;
+    } else if (n == "shadowless") {
+        l.shadowless = flag(item);
+    } else if (n == "fade_distance") {
+        if ((v = wantNumber(item, 9, 0, "0 or more"))) l.fadeDistance = *v;
+    } else if (n == "fade_power") {
+        if ((v = wantNumber(item, 10, 0, "0 or more"))) l.fadePower = *v;
+    } else {
+        return spotItem(l, n, item) || areaItem(l, n, item);
+    }
+    return true;
+}
+
+constexpr const char* kLightItems =
+    "position, color, shadowless, fade_distance, fade_power, spotlight, point_at, radius, "
+    "falloff, tightness, area_light, adaptive, jitter, circular, orient";
+
 void DirectiveReader::light(const Stmt& s) {
     Light l;
     target(DirectiveTarget::Light, static_cast<uint32_t>(g_.scene.lights.size()));
-    items(s, "light", "position, color", [&](std::string_view n, const DirectiveItem& item) {
-        if (n == "position") {
-            if (auto v = wantVector(item, 0)) l.position = *v;
-        } else if (n == "color" || n == "colour") {
-            if (auto v = wantVector(item, 3)) l.color = *v;
-        } else {
-            return false;
-        }
-        return true;
+    std::vector<std::string_view> given;
+    items(s, "light", kLightItems, [&](std::string_view n, const DirectiveItem& item) {
+        given.push_back(n);
+        return lightItem(l, n, item);
     });
+    checkLight(s, l, given);
     g_.scene.lights.push_back(l);
+}
+
+// The items that need another: spotlight's, area_light's; and what POV-Ray cannot do.
+void DirectiveReader::checkLight(const Stmt& s, const Light& l,
+                                 const std::vector<std::string_view>& given) {
+    const bool area = std::find(given.begin(), given.end(), "area_light") != given.end();
+    for (std::string_view n : given) {
+        if (!l.spotlight && (n == "point_at" || n == "radius" || n == "falloff" ||
+                             n == "tightness"))
+            ctx_.error(s.tok, fmt::format("'{}' needs 'spotlight' in the same light", n));
+        if (!area && (n == "adaptive" || n == "jitter" || n == "circular" || n == "orient"))
+            ctx_.error(s.tok, fmt::format("'{}' needs 'area_light' in the same light", n));
+    }
+    if (l.spotlight && l.shadowless)
+        ctx_.error(s.tok, "a light cannot be both 'spotlight' and 'shadowless' (POV-Ray 3.7 "
+                          "makes a shadowless light a fill light, which has no cone)");
+    if (l.circular && (l.size1 <= 1 || l.size2 <= 1))
+        ctx_.error(s.tok, "a 'circular' area_light needs sizes greater than 1");
 }
 
 void DirectiveReader::background(const Stmt& s) {
     if (!once(backgroundSeen_, s, "background")) return;
     target(DirectiveTarget::Background);
     if (auto v = vectorValue(ast_.items[s.first], 0)) g_.scene.background = *v;
+}
+
+// fog's values are constants (docs/language.md section 10).
+bool DirectiveReader::fogItem(Fog& f, std::string_view n, const DirectiveItem& item) {
+    const char* what = "fog's values";
+    if (n == "color" || n == "colour") {
+        if (!oneValue(item)) return true;
+        if (!item.vector) {
+            ctx_.error(item.nameTok, "the fog's 'color' takes a vector '<r, g, b>'");
+            return true;
+        }
+        for (int i = 0; i < 3; ++i)
+            if (auto c = constValue(item.e[i], what)) f.color[i] = *c;
+        return true;
+    }
+    double* target = n == "distance"     ? &f.distance
+                     : n == "filter"     ? &f.filter
+                     : n == "transmit"   ? &f.transmit
+                     : n == "fog_offset" ? &f.offset
+                     : n == "fog_alt"    ? &f.alt
+                                         : nullptr;
+    double type = 0;
+    if (n == "fog_type") target = &type;
+    if (!target) return false;
+    if (!oneValue(item)) return true;
+    if (item.vector) {
+        ctx_.error(item.nameTok,
+                   fmt::format("'{}' takes a number, not a vector", clip(ctx_.text(item.nameTok))));
+        return true;
+    }
+    const auto v = constValue(item.e[0], what);
+    if (!v) return true;
+    const bool unit = n == "filter" || n == "transmit";
+    if (n == "fog_type" && !(*v == 1 || *v == 2))
+        ctx_.error(item.nameTok, fmt::format("'fog_type' must be 1 (constant) or 2 (ground), "
+                                             "found {}",
+                                             *v));
+    else if ((n == "distance" || n == "fog_alt") && !(*v > 0))
+        ctx_.error(item.nameTok, fmt::format("'{}' must be greater than 0, found {}", n, *v));
+    else if (unit && !(*v >= 0 && *v <= 1))
+        ctx_.error(item.nameTok, fmt::format("'{}' must be from 0 to 1, found {}", n, *v));
+    else if (n == "fog_type")
+        f.type = static_cast<int>(*v);
+    else
+        *target = *v;
+    return true;
+}
+
+void DirectiveReader::fog(const Stmt& s) {
+    if (!once(fogSeen_, s, "fog")) return;
+    Fog f;
+    std::vector<std::string_view> given;
+    items(s, "fog", "distance, color, filter, transmit, fog_type, fog_offset, fog_alt",
+          [&](std::string_view n, const DirectiveItem& item) {
+              given.push_back(n);
+              return fogItem(f, n, item);
+          });
+    auto has = [&](std::string_view n) {
+        return std::find(given.begin(), given.end(), n) != given.end();
+    };
+    if (!has("distance")) ctx_.error(s.tok, "a fog needs a 'distance'");
+    if (f.type != 2)
+        for (std::string_view n : {"fog_offset", "fog_alt"})
+            if (has(n)) ctx_.error(s.tok, fmt::format("'{}' needs 'fog_type 2' (ground fog)", n));
+    f.enabled = f.distance > 0;
+    g_.scene.fog = f;
 }
 
 }  // namespace
@@ -244,6 +481,9 @@ void readDirectives(BuildContext& ctx, const Names& names, ExprCompiler& exprs) 
                 break;
             case Kw::Background:
                 reader.background(s);
+                break;
+            case Kw::Fog:
+                reader.fog(s);
                 break;
             case Kw::SkySphere:
                 reader.skySphere(s);

@@ -347,6 +347,14 @@ class Printer {
         return s + ">";
     }
 
+    std::string value(const DirectiveItem& item) const {
+        return item.vector ? vector(item) : expr(item.e[0]);
+    }
+    // A vector ends at its '>', the token after its last component.
+    uint32_t lastToken(const DirectiveItem& item) const {
+        return item.vector ? ast_.exprs[item.e[2]].to + 1 : ast_.exprs[item.e[0]].to;
+    }
+
     // `camera { location <4, -6, 3>  look_at <0, 0, 0.5> }` on one line when it fits,
     // else one item per line.
     std::string directive(const Stmt& s) const {
@@ -358,12 +366,19 @@ class Printer {
         if (atoms) list = materialItems(s);
         for (uint32_t k = 0; !atoms && k < s.count; ++k) {
             const DirectiveItem& item = ast_.items[s.first + k];
-            // A vector ends at its '>', the token after its last component.
-            const uint32_t last =
-                item.vector ? ast_.exprs[item.e[2]].to + 1 : ast_.exprs[item.e[0]].to;
-            list.push_back(
-                {{t_[item.nameTok].offset, endOf(last)},
-                 cat({text(item.nameTok), " ", item.vector ? vector(item) : expr(item.e[0])})});
+            if (item.flag) {
+                list.push_back({{t_[item.nameTok].offset, endOf(item.nameTok)},
+                                std::string(text(item.nameTok))});
+                continue;
+            }
+            // An item's values: this one and those after commas.
+            std::string line = cat({text(item.nameTok), " ", value(item)});
+            const DirectiveItem* last = &item;
+            for (uint32_t m = 0; m < item.more && k + 1 < s.count; ++m) {
+                last = &ast_.items[s.first + ++k];
+                line += cat({", ", value(*last)});
+            }
+            list.push_back({{t_[item.nameTok].offset, endOf(lastToken(*last))}, line});
         }
         uint32_t open = s.tok;
         while (t_[open].kind != Tok::LBrace) ++open;

@@ -36,7 +36,22 @@ void expectSameScene(const Scene& a, const Scene& b) {
     for (size_t k = 0; k < a.lights.size(); ++k) {
         expectSameVec(a.lights[k].position, b.lights[k].position);
         expectSameVec(a.lights[k].color, b.lights[k].color);
+        expectSameVec(a.lights[k].pointAt, b.lights[k].pointAt);
+        expectSameVec(a.lights[k].axis1, b.lights[k].axis1);
+        expectSameVec(a.lights[k].axis2, b.lights[k].axis2);
+        EXPECT_EQ(a.lights[k].size1, b.lights[k].size1);
+        EXPECT_EQ(a.lights[k].size2, b.lights[k].size2);
+        EXPECT_EQ(a.lights[k].adaptive, b.lights[k].adaptive);
+        EXPECT_EQ(a.lights[k].spotlight, b.lights[k].spotlight);
+        EXPECT_EQ(a.lights[k].shadowless, b.lights[k].shadowless);
+        EXPECT_EQ(a.lights[k].radius, b.lights[k].radius);
+        EXPECT_EQ(a.lights[k].fadeDistance, b.lights[k].fadeDistance);
     }
+    EXPECT_EQ(a.fog.enabled, b.fog.enabled);
+    EXPECT_EQ(a.fog.type, b.fog.type);
+    EXPECT_EQ(a.fog.distance, b.fog.distance);
+    expectSameVec(a.fog.color, b.fog.color);
+    EXPECT_EQ(a.fog.alt, b.fog.alt);
     expectSameVec(a.background, b.background);
     EXPECT_EQ(a.settings.seed, b.settings.seed);
     EXPECT_EQ(a.settings.maxDepth, b.settings.maxDepth);
@@ -206,6 +221,22 @@ TEST(Formatter, CommentsInADirectiveStayWithTheirItems) {
         "}\n"
         "sphere\n";
     EXPECT_EQ(format(text), expected);
+    EXPECT_EQ(format(expected), expected);
+}
+
+// Section 10's light items: flags alone, area_light's values after commas, and fog.
+TEST(Formatter, LightFlagsAreaLightAndFog) {
+    const std::string messy =
+        "light{position<1,2,3>;spotlight point_at <0,0,0>,radius 10\n tightness 2}\n"
+        "light { area_light <1,0,0> , <0,1,0>,4,2 adaptive 1 jitter\nshadowless }\n"
+        "fog{fog_type 2 distance 3,color <1,1,1> fog_alt 0.5}\n"
+        "sphere\n";
+    const std::string expected =
+        "light { position <1, 2, 3>  spotlight  point_at <0, 0, 0>  radius 10  tightness 2 }\n"
+        "light { area_light <1, 0, 0>, <0, 1, 0>, 4, 2  adaptive 1  jitter  shadowless }\n"
+        "fog { fog_type 2  distance 3  color <1, 1, 1>  fog_alt 0.5 }\n"
+        "sphere\n";
+    EXPECT_EQ(format(messy), expected);
     EXPECT_EQ(format(expected), expected);
 }
 

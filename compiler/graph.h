@@ -218,9 +218,39 @@ struct Camera {
     double angle = 40;  // horizontal field of view, degrees
 };
 
+// A POV-Ray 3.7 light_source (docs/language.md sections 7 and 10; tracer/lights.h has the
+// formulas). The numbered fields are those a TimedValue may set (scene_time.cpp).
 struct Light {
-    Vec3 position{10, -20, 30};
-    Vec3 color{1, 1, 1};
+    Vec3 position{10, -20, 30};  // fields 0-2
+    Vec3 color{1, 1, 1};         // 3-5
+    Vec3 pointAt{0, 0, 1};       // 6-8: a spotlight's axis points from position to here
+    double fadeDistance = 0;     // 9: with fade_power > 0, 2 / (1 + (d / fade_distance)^p)
+    double fadePower = 0;        // 10
+    double radius = 30;          // 11: spotlight, degrees (full light inside)
+    double falloff = 45;         // 12: spotlight, degrees (no light outside)
+    double tightness = 0;        // 13: spotlight, cos^tightness
+    bool spotlight = false;
+    bool shadowless = false;  // POV-Ray's fill light: no shadows and no highlights
+    // area_light <axis1>, <axis2>, size1, size2 (size1 * size2 > 1 makes it an area light)
+    Vec3 axis1{0, 0, 0}, axis2{0, 0, 0};
+    int size1 = 1, size2 = 1;
+    int adaptive = 100;   // POV-Ray's default: subdivide to the full grid
+    bool jitter = false;  // rendered with a fixed pseudo-random jitter; not reproducible in POV
+    bool circular = false;  // the grid's square shells mapped to circles
+    bool orient = false;    // the axes turned to face each lit point
+    bool areaLight() const { return size1 * size2 > 1; }
+};
+inline constexpr uint8_t kLightFields = 14;
+
+// fog { } (docs/language.md section 10): POV-Ray 3.7's constant (type 1) or ground fog
+// (type 2, altitude along z).
+struct Fog {
+    bool enabled = false;
+    int type = 1;
+    double distance = 0;
+    Vec3 color{0, 0, 0};
+    double filter = 0, transmit = 0;
+    double offset = 0, alt = 1;  // ground fog: density 1 below offset, 1/(1+h^2) above
 };
 
 // POV-Ray 3.7's pigment colour and classic finish, with POV-Ray's defaults.
@@ -263,6 +293,7 @@ struct Scene {
     Camera camera;
     std::vector<Light> lights;  // the builder fills in the default light when none is given
     Vec3 background{0, 0, 0};
+    Fog fog;
     // sky_sphere { pigment { ... } } (section 10): the pigment at a missed ray's direction
     // in scene coordinates, instead of the background.
     bool skySphere = false;
@@ -288,7 +319,8 @@ struct TimeRange {
 
 // A directive's value that reads `clock` or `frame`, and the number it sets:
 //   Camera:     location x y z (fields 0-2), look_at (3-5), sky (6-8), angle (9)
-//   Light:      lights[index]: position (0-2), color (3-5)
+//   Light:      lights[index]: position (0-2), color (3-5), point_at (6-8), fade_distance (9),
+//               fade_power (10), radius (11), falloff (12), tightness (13)
 //   Background: x y z (0-2)
 //   Material:   materials[index]: color (0-2), ambient (3), diffuse (4), phong (5),
 //               phong_size (6), reflection (7)

@@ -84,6 +84,7 @@ enum class Kw : uint8_t {
     Background,
     Material,
     Settings,
+    Fog,
     SkySphere,
     // CSG
     Paint,

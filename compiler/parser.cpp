@@ -409,7 +409,9 @@ class Parser {
         ast_.stmts.push_back(s);
     }
 
-    // block -> '{' { item | separator } '}'      item -> IDENT (vector | expr)
+    // block -> '{' { item | separator } '}'
+    // item  -> IDENT [value { ',' value }]      value -> vector | expr
+    // A name followed by '}', a separator or another name is a flag (`spotlight`).
     void block(std::vector<DirectiveItem>& items) {
         expect(Tok::LBrace, "'{'");
         for (;;) {
@@ -421,14 +423,37 @@ class Parser {
             DirectiveItem item;
             item.nameTok = pos();
             ++p_;
-            if (at(Tok::Lt)) {
-                vector(item);
-            } else {
-                item.e[0] = expr();
+            if (at(Tok::RBrace) || at(Tok::Ident) || isSeparator(tok().kind)) {
+                item.flag = true;
+                items.push_back(item);
+                continue;
             }
+            const size_t head = items.size();
+            itemValue(item);
             items.push_back(item);
+            // A comma before another value continues the item; before a name it separates.
+            while (at(Tok::Comma) && startsValue(tok(1)) && items[head].more < 255) {
+                ++p_;
+                DirectiveItem next;
+                next.nameTok = item.nameTok;
+                itemValue(next);
+                items.push_back(next);
+                ++items[head].more;
+            }
         }
         ++p_;
+    }
+
+    static bool startsValue(const Token& t) {
+        return !(t.kind == Tok::Ident || t.kind == Tok::RBrace || t.kind == Tok::End ||
+                 isSeparator(t.kind));
+    }
+
+    void itemValue(DirectiveItem& item) {
+        if (at(Tok::Lt))
+            vector(item);
+        else
+            item.e[0] = expr();
     }
 
     // A material's body, in POV-Ray's free syntax (ast.h's Atom):

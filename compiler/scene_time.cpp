@@ -26,7 +26,10 @@ double* targetOf(Graph& g, const TimedValue& tv) {
         }
         case DirectiveTarget::Light: {
             Light& l = g.scene.lights[tv.index];
-            return vectorField(f < 3 ? l.position : l.color, f % 3);
+            double* scalars[] = {&l.fadeDistance, &l.fadePower, &l.radius, &l.falloff,
+                                 &l.tightness};
+            if (f >= 9) return scalars[f - 9];
+            return vectorField(f < 3 ? l.position : (f < 6 ? l.color : l.pointAt), f % 3);
         }
         case DirectiveTarget::Background:
             return vectorField(g.scene.background, f);

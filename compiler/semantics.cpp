@@ -39,8 +39,12 @@ Semantics::Semantics(const Graph& g)
 void Semantics::transformStep(NodeId n, const PathState& s, StepScratch& scratch,
                               Step& step) const {
     StepScratch::Matrices& m = scratch.matrices.emplace();
-    m.forward = transformMatrix(g_, n, EvalState{s.frame, s.path});
-    m.inverse = m.forward.inverse();
+    if (scratch.memo) {
+        scratch.memo->transform(n, EvalState{s.frame, s.path}, m.forward, m.inverse);
+    } else {
+        m.forward = transformMatrix(g_, n, EvalState{s.frame, s.path});
+        m.inverse = m.forward.inverse();
+    }
     step.child = g_.child(n);
     step.forward = &m.forward;
     step.inverse = &m.inverse;

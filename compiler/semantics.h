@@ -32,6 +32,7 @@
 
 #include "eval.h"
 #include "graph.h"
+#include "step_memo.h"
 
 namespace pcsg {
 
@@ -55,12 +56,15 @@ struct Step {
 // Storage a walker lends to enter(): the new frame of a C-node (Graph::slotCount() values,
 // not the incoming frame) and the matrices of a T-node that depends on parameters (made
 // only then: the walk takes a step per node of every ray).
+// A walker may also lend its StepMemo (step_memo.h), which remembers the results of C-
+// and T-steps by what they read.
 struct StepScratch {
     struct Matrices {
         Affine forward, inverse;
     };
     double* frame = nullptr;
     std::optional<Matrices> matrices;
+    StepMemo* memo = nullptr;
 };
 
 class Semantics {
@@ -87,12 +91,16 @@ class Semantics {
         switch (node.kind) {
             case NodeKind::Select:
                 step.state.depth = selectDepth(n, s);
-                step.rule = selectRule(g_, n, EvalState{s.frame, s.path});
+                step.rule = scratch.memo ? scratch.memo->select(n, EvalState{s.frame, s.path})
+                                         : selectRule(g_, n, EvalState{s.frame, s.path});
                 step.state.path = pathRule(s.path, step.rule);
                 step.child = g_.child(n, step.rule);
                 break;
             case NodeKind::Calc:
-                applyCalc(g_, n, EvalState{s.frame, s.path}, scratch.frame);
+                if (scratch.memo)
+                    scratch.memo->calc(n, EvalState{s.frame, s.path}, scratch.frame);
+                else
+                    applyCalc(g_, n, EvalState{s.frame, s.path}, scratch.frame);
                 step.state.frame = scratch.frame;
                 step.child = g_.child(n);
                 break;

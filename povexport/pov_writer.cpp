@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "pov_lights.h"
 #include "pov_texture.h"
 #include "primitive_table.h"
 
@@ -267,13 +268,8 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
     o.put("#version 3.7;\n");
     o.put("global_settings {{ assumed_gamma 1.0 max_trace_level 5 }}\n\n");
     o.put("{}\n", povCamera(g.scene.camera, opt.width, opt.height));
-    for (const Light& l : g.scene.lights) {
-        o.put("light_source {{ ");
-        o.vec(l.position);
-        o.put(" color rgb ");
-        o.vec(l.color);
-        o.put(" }}\n");
-    }
+    for (const Light& l : g.scene.lights) o.put("{}\n", povLight(l));
+    if (g.scene.fog.enabled) o.put("{}\n", povFog(g.scene.fog));
     o.put("background {{ color rgb ");
     o.vec(g.scene.background);
     o.put(" }}\n");

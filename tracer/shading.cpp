@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "fog.h"
+#include "lights.h"
 #include "perturb.h"
 #include "pigment.h"
 
@@ -37,7 +39,7 @@ Vec3 highlight(double intensity, const Vec3& lightColour, const Material& m, con
 
 // Diffuse, phong and specular of one light seen along direction l (unit, toward the light).
 Vec3 Shader::lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
-                 const Material& m, const Vec3& pigment) const {
+                 const Material& m, const Vec3& pigment, bool highlights) const {
     Vec3 colour{0, 0, 0};
     const double cosAngle = dot(n, l);
     if (m.diffuse > 0) {
@@ -45,6 +47,7 @@ Vec3 Shader::lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightC
         const double intensity = m.brilliance != 1 ? std::pow(c, m.brilliance) : c;
         colour += mul(lightColour, pigment) * (intensity * m.diffuse);
     }
+    if (!highlights) return colour;
     if (m.phong > 0) {
         const Vec3 r = d - n * (2 * dot(d, n));
         const double c = dot(r, l);
@@ -72,14 +75,9 @@ Vec3 Shader::local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& 
     Vec3 colour = pigment * (m.ambient * C::kAmbientLight);
     if (!(m.diffuse != 0 || m.phong != 0 || m.specular != 0)) return colour;
     for (const Light& light : g_.scene.lights) {
-        Vec3 l = light.position - p;
-        const double dist = length(l);
-        if (!(dist > 0)) continue;
-        l = l / dist;
-        if (dot(n, l) < C::kEpsilon) continue;  // the light is behind the surface
-        ++rays_;
-        if (tracer_.anyHit(p, l, C::kShadowTolerance, dist - C::kShadowTolerance)) continue;
-        colour += lit(n, d, l, light.color, m, pigment);
+        ArrivingLight a;  // lights.h: spot, fade, area and shadowless lights
+        if (lightArriving(light, p, n, tracer_, rays_, a))
+            colour += lit(n, d, a.dir, a.colour, m, pigment, a.highlights);
     }
     return colour;
 }
@@ -130,7 +128,13 @@ Vec3 Shader::shade(const Ray& ray) {
     for (int level = 1; level <= C::kMaxTraceLevel; ++level) {
         ++rays_;
         SurfaceHit hit;
-        if (!tracer_.firstHit(origin, dir, C::kMinIsectDepth, C::kMaxDistance, hit)) {
+        const bool found = tracer_.firstHit(origin, dir, C::kMinIsectDepth, C::kMaxDistance, hit);
+        if (g_.scene.fog.enabled) {  // fog.h: colour = add + attenuation x the colour behind
+            const FogEffect f = fogAlong(g_.scene.fog, origin, dir, found ? hit.t : kFogMissDepth);
+            colour += mul(f.add, factor);
+            factor = mul(factor, f.attenuation);
+        }
+        if (!found) {
             colour += mul(skyColour(g_.scene, dir), factor);
             break;
         }

@@ -29,7 +29,10 @@
 //      * a highlight is in the light's colour; with finish `metallic k` it is Lc * (1 + k
 //        (1 - F) (pigment - 1)), F POV-Ray's empirical Fresnel term of acos(N . L):
 //        x = acos / (pi/2), F = clamp(0.014567225 / (x - 1.12)^2 - 0.011612903, 0, 1).
-//    No light attenuation with distance (POV-Ray's default fade_power 0).
+//    No light attenuation with distance (POV-Ray's default fade_power 0). Spotlights,
+//    fading, shadowless and area lights: lights.h (Shader::local asks lightArriving()
+//    for each light's direction and colour). Fog: fog.h (Shader::shade applies it to
+//    each ray segment: colour += factor x add, factor *= attenuation).
 //  - Reflection (ComputeReflectivity, reflection_type 0 or 1, falloff 1), with cos = -D . N:
 //      * without fresnel, amount = min when 1 - cos is 0, max when it is 1, else (1 - cos)
 //        max + cos min; the ray's weight is multiplied by max(min, max);
@@ -97,7 +100,7 @@ class Shader {
     Vec3 local(const Vec3& p, const Vec3& n, const Vec3& d, const Material& m, const Vec3& pigment);
     // Diffuse, phong and specular of one unshadowed light in direction l.
     Vec3 lit(const Vec3& n, const Vec3& d, const Vec3& l, const Vec3& lightColour,
-             const Material& m, const Vec3& pigment) const;
+             const Material& m, const Vec3& pigment, bool highlights = true) const;
 
     const Graph& g_;
     Tracer tracer_;

@@ -60,7 +60,7 @@ void TraceScene::markPaintFrames() {
 
 TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
                        const InstanceBoxOptions& instanceBoxOptions)
-    : g_(g), sem_(g), bounds_(std::move(bounds)) {
+    : g_(g), sem_(g), memoPlan_(g), bounds_(std::move(bounds)) {
     const size_t n = g.nodes.size();
     if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
     markPaintFrames();
@@ -124,6 +124,8 @@ Tracer::Tracer(const TraceScene& scene)
     rootFrame_.assign(std::max<size_t>(g_.slotCount(), 1), 0.0);
     initFrame(g_, rootFrame_.data());
     if (scene.instanceBoxes_) boxWorker_ = scene.instanceBoxes_->makeWorker();
+    if (scene.stepMemoLog2 > 0)
+        memo_ = std::make_unique<StepMemo>(g_, scene.memoPlan_, scene.stepMemoLog2);
     if (scene.instanceBoxes_ && scene.expansionBytesPerThread > 0)
         expansion_ = std::make_unique<UnrollCache>(scene, scene.expansionBytesPerThread);
 }
@@ -218,6 +220,7 @@ template <class Below, class Unrolled, class TransformBack>
     const Semantics& sem = scene_.sem_;
     const NodeKind kind = g_.nodes[n].kind;
     StepScratch scratch;
+    scratch.memo = memo_.get();
     if (kind == NodeKind::Select) {
         try {
             const uint32_t depth = sem.selectDepth(n, c);

@@ -53,6 +53,7 @@
 #include "operators.h"
 #include "primitives.h"
 #include "semantics.h"
+#include "step_memo.h"
 #include "unrolled_instances.h"
 
 namespace pcsg::tracer {
@@ -96,6 +97,10 @@ class TraceScene {
     // bytes; 0 turns them off.
     size_t expansionBytesPerThread = 16u << 20;
 
+    // Each tracer remembers the results of C- and T-steps (compiler/step_memo.h) in a table
+    // of 2^stepMemoLog2 entries (of 336 bytes); 0 turns it off.
+    uint32_t stepMemoLog2 = 12;
+
     // What entering each node means (with the fused chains of constant T-nodes).
     const Semantics& semantics() const { return sem_; }
 
@@ -117,6 +122,7 @@ class TraceScene {
     void markPaintFrames();
     const Graph& g_;
     Semantics sem_;
+    StepMemoPlan memoPlan_;
     Bounds bounds_;
     uint64_t recursionBound_ = 0;
     std::unique_ptr<InstanceBoxes> instanceBoxes_;
@@ -192,6 +198,7 @@ class Tracer {
     const Graph& g_;
     FrameStack frames_;
     InstanceBoxes::WorkerPtr boxWorker_;
+    std::unique_ptr<StepMemo> memo_;  // null: scene_.stepMemoLog2 is 0
     std::unique_ptr<UnrollCache> expansion_;
     std::vector<double> rootFrame_;
     std::vector<Span> spans_;

@@ -382,7 +382,7 @@ struct Tally {
 };
 
 // Fires `count` rays at the scene and compares the tracer with the reference, with and
-// without culling.
+// without culling, and with and without the step memo (the plain walk has neither).
 Tally compareWithReference(const char* text, int count, uint32_t seed) {
     Tally tally;
     auto c = compile(text);
@@ -399,6 +399,7 @@ Tally compareWithReference(const char* text, int count, uint32_t seed) {
     const TraceScene culled(g, computeBounds(g));
     TraceScene unculled(g, computeBounds(g));
     unculled.useBounds = false;
+    unculled.stepMemoLog2 = 0;
     Tracer tracer(culled), plain(unculled);
     RayGenerator gen(ref.box(), ref.instanceBoxes(), seed);
 
@@ -414,7 +415,7 @@ Tally compareWithReference(const char* text, int count, uint32_t seed) {
         // Culling never changes a result.
         if (found != found2 || (found && (hit.t != hit2.t || !(hit.normal == hit2.normal) ||
                                           hit.material != hit2.material)))
-            tally.fail(rayText(r) + ": culling changes the hit (with boxes: " +
+            tally.fail(rayText(r) + ": culling or the step memo changes the hit (with both: " +
                        (found ? "t " + std::to_string(hit.t) : std::string("none")) +
                        ", without: " +
                        (found2 ? "t " + std::to_string(hit2.t) : std::string("none")) + ")");

@@ -231,6 +231,21 @@ void verifySceneFrames(const std::string& scene, VerifyOptions o, const FramePla
     }
 }
 
+// A jittered area light samples other points in each renderer (POV-Ray draws random
+// numbers, the tracer a fixed hash): its penumbrae cannot agree pixel for pixel.
+void warnJitter(const std::string& scene) {
+    std::ostringstream ignored;  // compile errors are reported by the native render
+    const CompiledScene c = compileScene(scene, ignored);
+    if (!c.graph) return;
+    for (const Light& l : c.graph->scene.lights)
+        if (l.jitter && l.areaLight()) {
+            std::cerr << "pcsg verify: warning: " << scene
+                      << " has an area light with 'jitter', which POV-Ray samples at random: "
+                         "its soft shadows may differ\n";
+            return;
+        }
+}
+
 int runVerify(VerifyOptions o) {
     if (!addSceneDirectory(o)) return 2;
     FramePlan plan;
@@ -262,6 +277,7 @@ int runVerify(VerifyOptions o) {
     std::set<std::string> dirs = {"index.html"};  // the report's own page is taken
     for (const auto& scene : o.scenes) {
         if (!o.json && o.scenes.size() > 1) std::cerr << "verifying " << scene << " ...\n";
+        warnJitter(scene);
         verifySceneFrames(scene, o, plan, frames, dirs, root, results, status, written);
     }
     printSummary(results, o, root);

@@ -1,0 +1,173 @@
+// The walker's memory of C- and T-steps: see step_memo.h.
+#include "step_memo.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+
+namespace pcsg {
+
+namespace {
+
+// What one expression reads, added to `reads` (without repeats).
+void addReads(const Graph& g, ExprId id, std::vector<uint32_t>& reads, bool& usesPath) {
+    const Expr& e = g.exprs[id];
+    for (uint32_t pc = e.begin; pc < e.end; ++pc) {
+        const Instr& in = g.code[pc];
+        uint32_t r;
+        if (in.op == Op::Load)
+            r = in.a;
+        else if (in.op == Op::Clock)
+            r = StepMemoPlan::kClock;
+        else if (in.op == Op::Frame)
+            r = StepMemoPlan::kFrame;
+        else {
+            if (in.op == Op::Rand0 || in.op == Op::Choose) usesPath = true;
+            continue;
+        }
+        if (std::find(reads.begin(), reads.end(), r) == reads.end()) reads.push_back(r);
+    }
+}
+
+double readValue(const Graph& g, uint32_t r, const double* frame) {
+    if (r == StepMemoPlan::kClock) return g.time.clock;
+    if (r == StepMemoPlan::kFrame) return g.time.frame;
+    return frame[r];
+}
+
+// Doubles differ in their high bits (exponent and leading mantissa), so each value is
+// folded down as it is added, and the sum is finished with MurmurHash3's finaliser: the
+// table index takes the low bits.
+uint64_t add(uint64_t h, uint64_t v) {
+    return (h ^ v ^ (v >> 29)) * 0x9e3779b97f4a7c15ull;
+}
+
+uint64_t finish(uint64_t h) {
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ull;
+    return h ^ (h >> 33);
+}
+
+void toDoubles(const Affine& m, double* out) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) out[3 * i + j] = m.l[i][j];
+    out[9] = m.t.x, out[10] = m.t.y, out[11] = m.t.z;
+}
+
+void fromDoubles(const double* in, Affine& m) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) m.l[i][j] = in[3 * i + j];
+    m.t = Vec3{in[9], in[10], in[11]};
+}
+
+}  // namespace
+
+StepMemoPlan::StepMemoPlan(const Graph& g) : nodes_(g.nodes.size()) {
+    std::vector<uint32_t> reads;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        const Node& node = g.nodes[n];
+        NodePlan& p = nodes_[n];
+        reads.clear();
+        if (node.kind == NodeKind::Calc) {
+            const Calc& c = g.calcs[node.payload];
+            if (c.count > kMaxWrites) continue;
+            for (uint32_t i = 0; i < c.count; ++i)
+                addReads(g, g.assignments[c.first + i].value, reads, p.usesPath);
+        } else if (node.kind == NodeKind::Select) {
+            const Module& m = g.modules[node.payload];
+            if (!m.notationB) addReads(g, m.select, reads, p.usesPath);
+            for (ExprId c : m.conditions)
+                if (c != kNone) addReads(g, c, reads, p.usesPath);
+        } else if (node.kind == NodeKind::Transform) {
+            const Transform& t = g.transforms[node.payload];
+            if (t.constant) continue;
+            for (uint32_t i = 0; i < t.argCount; ++i)
+                addReads(g, g.args[t.firstArg + i], reads, p.usesPath);
+        } else {
+            continue;
+        }
+        if (reads.size() > kMaxReads) continue;
+        p.firstRead = static_cast<uint32_t>(reads_.size());
+        p.readCount = static_cast<uint32_t>(reads.size());
+        p.memoised = true;
+        reads_.insert(reads_.end(), reads.begin(), reads.end());
+    }
+}
+
+StepMemo::StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2)
+    : g_(g), plan_(plan), table_(size_t{1} << entriesLog2), mask_((1u << entriesLog2) - 1) {}
+
+bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, Entry*& e) {
+    uint64_t key[StepMemoPlan::kMaxReads];
+    const uint32_t* reads = plan_.reads(p);
+    uint64_t h = add(0, n);
+    for (uint32_t i = 0; i < p.readCount; ++i) {
+        key[i] = std::bit_cast<uint64_t>(readValue(g_, reads[i], in.frame));
+        h = add(h, key[i]);
+    }
+    const uint64_t path = p.usesPath ? in.path : 0;
+    if (p.usesPath) h = add(h, path);
+    e = &table_[finish(h) & mask_];
+    bool same = e->node == n && e->path == path;
+    for (uint32_t i = 0; same && i < p.readCount; ++i) same = e->key[i] == key[i];
+    if (same) {
+        ++hits_;
+        return true;
+    }
+    ++misses_;
+    e->node = kNone;  // filled in by the caller once the step has succeeded
+    e->path = path;
+    for (uint32_t i = 0; i < p.readCount; ++i) e->key[i] = key[i];
+    return false;
+}
+
+uint32_t StepMemo::select(NodeId n, EvalState in) {
+    const StepMemoPlan::NodePlan& p = plan_.of(n);
+    if (!p.memoised) return selectRule(g_, n, in);
+    Entry* e;
+    if (lookup(n, p, in, e)) return static_cast<uint32_t>(e->out[0]);
+    const uint32_t rule = selectRule(g_, n, in);
+    e->out[0] = rule;
+    e->node = n;
+    return rule;
+}
+
+void StepMemo::calc(NodeId n, EvalState in, double* out) {
+    const StepMemoPlan::NodePlan& p = plan_.of(n);
+    if (!p.memoised) return applyCalc(g_, n, in, out);
+    const Calc& c = g_.calcs[g_.nodes[n].payload];
+    const Assignment* as = g_.assignments.data() + c.first;
+    Entry* e;
+    if (lookup(n, p, in, e)) {
+        std::memcpy(out, in.frame, g_.slotCount() * sizeof(double));
+        for (uint32_t i = 0; i < c.count; ++i) out[as[i].slot] = e->out[i];
+        return;
+    }
+    applyCalc(g_, n, in, out);
+    for (uint32_t i = 0; i < c.count; ++i) e->out[i] = out[as[i].slot];
+    e->node = n;
+}
+
+void StepMemo::transform(NodeId n, EvalState in, Affine& forward, Affine& inverse) {
+    const StepMemoPlan::NodePlan& p = plan_.of(n);
+    if (!p.memoised) {
+        forward = transformMatrix(g_, n, in);
+        inverse = forward.inverse();
+        return;
+    }
+    Entry* e;
+    if (lookup(n, p, in, e)) {
+        fromDoubles(e->out, forward);
+        fromDoubles(e->out + 12, inverse);
+        return;
+    }
+    forward = transformMatrix(g_, n, in);
+    inverse = forward.inverse();
+    toDoubles(forward, e->out);
+    toDoubles(inverse, e->out + 12);
+    e->node = n;
+}
+
+}  // namespace pcsg

@@ -1,0 +1,83 @@
+// A walker's memory of the steps it has already taken: the rule an S-node selects, the new
+// values of a C-node and the matrices of a T-node whose arguments read parameters, keyed
+// by exactly what they read.
+//
+// A ray walks the graph from the root, so every ray that reaches an instance recomputes
+// the same selections, C-nodes and T-node matrices on the way (a growing tree's lengths and angles
+// are all functions of the clock and the depth: half of the tracer's instructions went there).
+// Their results are functions of a few values: the parameter slots their expressions
+// load, the instance path when they call rand() or choose(), and the time when they read
+// clock or frame. StepMemo keeps the last results per thread in a direct-mapped table,
+// keyed by those values bit for bit, so a hit gives the same numbers the step would
+// compute (and a step that would throw is never stored: it throws again).
+//
+// Semantics::enter() consults it when the walker lends one in StepScratch::memo; a node
+// that reads more than kMaxReads values, or a C-node that writes more than kMaxWrites
+// slots, is always computed.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "eval.h"
+#include "graph.h"
+
+namespace pcsg {
+
+// What each C- and T-node reads and writes: computed once per graph, shared by threads.
+class StepMemoPlan {
+  public:
+    static constexpr uint32_t kMaxReads = 16;
+    static constexpr uint32_t kMaxWrites = 24;
+    static constexpr uint32_t kClock = UINT32_MAX;      // a read of `clock`
+    static constexpr uint32_t kFrame = UINT32_MAX - 1;  // a read of `frame`
+
+    explicit StepMemoPlan(const Graph& g);
+
+    struct NodePlan {
+        uint32_t firstRead = 0,
+                 readCount = 0;  // reads_[firstRead, +readCount): slots or kClock/kFrame
+        bool usesPath = false;
+        bool memoised = false;
+    };
+    const NodePlan& of(NodeId n) const { return nodes_[n]; }
+    const uint32_t* reads(const NodePlan& p) const { return reads_.data() + p.firstRead; }
+
+  private:
+    std::vector<NodePlan> nodes_;
+    std::vector<uint32_t> reads_;
+};
+
+// Per thread: the table (a few thousand entries, a fixed size).
+class StepMemo {
+  public:
+    StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2 = 12);
+
+    // Semantics' S-node step: the rule selected (0-based).
+    uint32_t select(NodeId n, EvalState in);
+    // Semantics' C-node step: the new frame into `out` (Graph::slotCount() values).
+    void calc(NodeId n, EvalState in, double* out);
+    // Semantics' T-node step for a T-node whose arguments are not constant.
+    void transform(NodeId n, EvalState in, Affine& forward, Affine& inverse);
+
+    uint64_t hits() const { return hits_; }
+    uint64_t misses() const { return misses_; }
+
+  private:
+    struct Entry {
+        NodeId node = kNone;
+        uint64_t path = 0;
+        uint64_t key[StepMemoPlan::kMaxReads];  // the values read, as bits
+        double out[StepMemoPlan::kMaxWrites];   // C: written values; T: forward, inverse
+    };
+    // The entry for (n, in): found (true) or to fill (false); `key` gets the read values.
+    bool lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, Entry*& e);
+
+    const Graph& g_;
+    const StepMemoPlan& plan_;
+    std::vector<Entry> table_;
+    uint32_t mask_;
+    uint64_t hits_ = 0, misses_ = 0;
+};
+
+}  // namespace pcsg

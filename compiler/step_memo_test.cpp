@@ -1,0 +1,149 @@
+// StepMemo gives exactly what the steps compute, whatever it remembers.
+#include "step_memo.h"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstring>
+#include <random>
+
+#include "compile_test_util.h"
+
+namespace pcsg {
+namespace {
+
+using testing::compile;
+
+// C-nodes, T-nodes and S-nodes that read slots, rand(), choose() and the clock.
+constexpr const char* kScene = R"(
+{n = 3; a = 1; b = 2} S
+S if(n > 0, if(b > 3, 3, 2), 1)
+1: S -> sphere
+2: S -> {n = n - 1; a = a + rand(); b = b * 2} rotx(a*30) uscale(1 + b/10) S ∪
+        {n = n - 1} move(clock, a, 0) S
+3: S -> {n = n - 1} T
+T choose(1, 1 + a)
+1: T -> scale(1, 1 + b, 2) S
+2: T -> move(0, 0, rand()) cube
+)";
+
+// A frame of small values, so that the same keys come back.
+std::vector<double> randomFrame(const Graph& g, std::mt19937_64& rng) {
+    std::vector<double> f(g.slotCount());
+    for (double& v : f) v = static_cast<double>(rng() % 4);
+    return f;
+}
+
+bool sameBits(const double* a, const double* b, size_t n) {
+    return std::memcmp(a, b, n * sizeof(double)) == 0;
+}
+
+bool sameAffine(const Affine& a, const Affine& b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// Each step through the memo against the step computed directly, many times over.
+void checkAgainstDirect(Graph& g, StepMemo& memo, int trials) {
+    std::mt19937_64 rng(7);
+    const StepMemoPlan plan(g);
+    std::vector<double> direct(g.slotCount()), remembered(g.slotCount());
+    for (int k = 0; k < trials; ++k) {
+        const std::vector<double> frame = randomFrame(g, rng);
+        const EvalState s{frame.data(), kRootPath + rng() % 3};
+        g.time.clock = static_cast<double>(rng() % 2);
+        for (NodeId n = 0; n < g.nodes.size(); ++n) {
+            SCOPED_TRACE(::testing::Message() << "node " << n << " trial " << k);
+            switch (g.nodes[n].kind) {
+                case NodeKind::Calc:
+                    applyCalc(g, n, s, direct.data());
+                    memo.calc(n, s, remembered.data());
+                    ASSERT_TRUE(sameBits(direct.data(), remembered.data(), direct.size()));
+                    break;
+                case NodeKind::Transform: {
+                    if (g.transforms[g.nodes[n].payload].constant) break;
+                    Affine f, i;
+                    memo.transform(n, s, f, i);
+                    const Affine d = transformMatrix(g, n, s);
+                    ASSERT_TRUE(sameAffine(f, d));
+                    ASSERT_TRUE(sameAffine(i, d.inverse()));
+                    break;
+                }
+                case NodeKind::Select:
+                    ASSERT_EQ(memo.select(n, s), selectRule(g, n, s));
+                    break;
+                default:
+                    break;
+            }
+        }
+    }
+}
+
+TEST(StepMemo, GivesWhatTheStepsComputeAndRemembers) {
+    auto c = compile(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const StepMemoPlan plan(*c->graph);
+    StepMemo memo(*c->graph, plan);
+    checkAgainstDirect(*c->graph, memo, 400);
+    // Few distinct keys: most steps are remembered.
+    EXPECT_GT(memo.hits(), 4 * memo.misses());
+}
+
+TEST(StepMemo, ATinyTableEvictsButNeverMixesUpEntries) {
+    auto c = compile(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const StepMemoPlan plan(*c->graph);
+    StepMemo memo(*c->graph, plan, 1);  // two entries for all nodes
+    checkAgainstDirect(*c->graph, memo, 200);
+    EXPECT_GT(memo.misses(), 0u);
+}
+
+TEST(StepMemo, TheInstancePathIsPartOfTheKeyOnlyForRandomSteps) {
+    auto c = compile(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    const StepMemoPlan plan(g);
+    int random = 0, plain = 0;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        if (g.nodes[n].kind != NodeKind::Calc) continue;
+        const StepMemoPlan::NodePlan& p = plan.of(n);
+        EXPECT_TRUE(p.memoised);
+        (p.usesPath ? random : plain) += 1;
+    }
+    EXPECT_EQ(random, 1);  // {n = n - 1; a = a + rand(); b = b * 2}
+    EXPECT_GE(plain, 2);
+}
+
+TEST(StepMemo, AStepThatFailsIsNotRemembered) {
+    auto c = compile(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    const StepMemoPlan plan(g);
+    StepMemo memo(g, plan);
+    // b = -10 makes uscale(1 + b/10) singular: the step throws every time it is taken.
+    std::vector<double> frame(g.slotCount(), 1.0);
+    for (size_t k = 0; k < g.slotCount(); ++k)
+        if (g.slotNames[k] == "b") frame[k] = -10;
+    int failing = 0;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        if (g.nodes[n].kind != NodeKind::Transform || g.transforms[g.nodes[n].payload].constant)
+            continue;
+        bool failsDirectly = false;
+        try {
+            transformMatrix(g, n, {frame.data(), kRootPath});
+        } catch (const RuntimeError&) {
+            failsDirectly = true;
+        }
+        failing += failsDirectly;
+        Affine f, i;
+        for (int k = 0; k < 3; ++k) {
+            if (failsDirectly)
+                EXPECT_THROW(memo.transform(n, {frame.data(), kRootPath}, f, i), RuntimeError);
+            else
+                EXPECT_NO_THROW(memo.transform(n, {frame.data(), kRootPath}, f, i));
+        }
+    }
+    EXPECT_EQ(failing, 1);
+}
+
+}  // namespace
+}  // namespace pcsg
