@@ -32,8 +32,12 @@ class MaterialReader : public PatternValues {
   public:
     MaterialReader(BuildContext& ctx, ExprCompiler& exprs, uint32_t index)
         : ctx_(ctx), ast_(ctx.ast), exprs_(exprs), m_(ctx.g.materials[index]), index_(index) {}
+    // Reads into `scratch` with constant values only (sky_sphere's pigment).
+    MaterialReader(BuildContext& ctx, ExprCompiler& exprs, Material& scratch)
+        : ctx_(ctx), ast_(ctx.ast), exprs_(exprs), m_(scratch), index_(0), constantOnly_(true) {}
 
     void body(const Stmt& s);
+    void skyBody(const Stmt& s);
 
   private:
     using Range = AtomRange;
@@ -79,8 +83,8 @@ class MaterialReader : public PatternValues {
     ExprCompiler& exprs_;
     Material& m_;
     uint32_t index_;
-    bool timed_ = false;      // the last value read reads the time
-    uint32_t colourTok_ = 0;  // the vector of the last colour read
+    bool constantOnly_ = false;  // no value may read the time
+    bool timed_ = false;         // the last value read reads the time
 };
 
 std::string MaterialReader::describeAtom(const Atom& a) const {
@@ -90,7 +94,7 @@ std::string MaterialReader::describeAtom(const Atom& a) const {
 // A value: a constant, or one that reads the time, kept as a TimedValue of this material.
 std::optional<double> MaterialReader::value(uint32_t expr, uint8_t field) {
     timed_ = false;
-    if (field == kConstant) return exprs_.constant(expr);
+    if (field == kConstant || constantOnly_) return exprs_.constant(expr);
     const auto v = exprs_.directiveValue(expr);
     if (!v) return std::nullopt;
     if (v->timed != kNone) {
@@ -158,11 +162,7 @@ std::optional<FilterColour> MaterialReader::colour(Range& r, const Atom& item, u
 
 // A pattern's colour (list colours, colour maps): a constant.
 std::optional<FilterColour> MaterialReader::colour(Range& r, const Atom& item) {
-    const auto c = colour(r, item, kConstant);
-    if (c && (c->filter != 0 || c->transmit != 0))
-        ctx_.error(colourTok_,
-                   "filter and transmit (transparency) are not implemented yet: they must be 0");
-    return c;
+    return colour(r, item, kConstant);
 }
 
 // A vector `<x, y, z>` after `item` (with numberToo, a number n is <n, n, n>): a constant.
@@ -204,7 +204,6 @@ std::optional<Vec3> MaterialReader::vector(Range& r, const Atom& item, bool numb
 std::optional<FilterColour> MaterialReader::colourComponents(const Atom& model, const Atom& v,
                                                              uint8_t field) {
     const std::string_view m = word(model);
-    colourTok_ = v.tok;
     const uint32_t want = m == "rgbft" ? 5 : (m == "rgbf" || m == "rgbt") ? 4 : 3;
     if (v.count != want) {
         ctx_.error(v.tok, fmt::format("'{}' takes a vector of {} components, found {}", clip(m),
@@ -511,7 +510,42 @@ void MaterialReader::interior(Range r) {
     }
 }
 
+// sky_sphere { pigment { ... } }: one pigment, nothing else.
+void MaterialReader::skyBody(const Stmt& s) {
+    Range r{s.first, s.first + s.count};
+    bool seen = false;
+    while (!r.done()) {
+        const Atom& item = ast_.atoms[r.i++];
+        if (item.kind != AtomKind::Word || word(item) != "pigment") {
+            if (item.kind == AtomKind::Word)
+                reject(r, item, "sky_sphere", "pigment");
+            else
+                ctx_.error(item.tok, fmt::format("expected a sky_sphere setting, found {}",
+                                                 describeAtom(item)));
+            continue;
+        }
+        const Atom* b = block(r, item);
+        if (!b) continue;
+        if (seen)
+            ctx_.error(item.tok,
+                       "sky_sphere takes one pigment (layered pigments are not "
+                       "supported)");
+        seen = true;
+        pigment(inside(*b));
+    }
+    if (!seen) ctx_.error(s.tok, "sky_sphere needs a pigment { ... }");
+}
+
 }  // namespace
+
+void readSkySphere(BuildContext& ctx, ExprCompiler& exprs, const Stmt& s) {
+    Material scratch;
+    MaterialReader(ctx, exprs, scratch).skyBody(s);
+    Scene& scene = ctx.g.scene;
+    scene.skySphere = true;
+    scene.skyPigment = scratch.pigment;
+    scene.skyColour = FilterColour{scratch.color, scratch.filter, scratch.transmit};
+}
 
 void readMaterial(BuildContext& ctx, ExprCompiler& exprs, const Stmt& s, uint32_t index) {
     MaterialReader(ctx, exprs, index).body(s);

@@ -13,4 +13,8 @@ namespace pcsg {
 // Reads the body of material statement `s` into ctx.g.materials[index].
 void readMaterial(BuildContext& ctx, ExprCompiler& exprs, const Stmt& s, uint32_t index);
 
+// Reads the body of a `sky_sphere { pigment { ... } }` directive into ctx.g.scene (its
+// values are constants).
+void readSkySphere(BuildContext& ctx, ExprCompiler& exprs, const Stmt& s);
+
 }  // namespace pcsg

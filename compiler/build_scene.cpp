@@ -25,6 +25,9 @@ class DirectiveReader {
     void light(const Stmt& s);
     void background(const Stmt& s);
     void fog(const Stmt& s);
+    void skySphere(const Stmt& s) {
+        if (once(skySeen_, s, "sky_sphere")) readSkySphere(ctx_, exprs_, s);
+    }
 
   private:
     bool once(uint32_t& seen, const Stmt& s, const char* what);
@@ -57,7 +60,7 @@ class DirectiveReader {
     const Ast& ast_;
     ExprCompiler& exprs_;
     uint32_t settingsSeen_ = kNoNode, cameraSeen_ = kNoNode, backgroundSeen_ = kNoNode,
-             fogSeen_ = kNoNode;
+             fogSeen_ = kNoNode, skySeen_ = kNoNode;
     DirectiveTarget target_ = DirectiveTarget::Camera;
     uint32_t index_ = 0;
     bool timed_ = false;  // the last value read reads the time
@@ -505,6 +508,9 @@ void readDirectives(BuildContext& ctx, const Names& names, ExprCompiler& exprs) 
                 break;
             case Kw::Fog:
                 reader.fog(s);
+                break;
+            case Kw::SkySphere:
+                reader.skySphere(s);
                 break;
             case Kw::Material:
                 if (auto it = names.materialOfName.find(s.nameTok);

@@ -361,11 +361,10 @@ class Printer {
         std::string head = text(s.tok);
         if (s.directive == Kw::Background) return head + " " + vector(ast_.items[s.first]);
         std::vector<Item> list;
-        if (s.directive == Kw::Material) {
-            head += cat({" ", text(s.nameTok)});
-            list = materialItems(s);
-        }
-        for (uint32_t k = 0; s.directive != Kw::Material && k < s.count; ++k) {
+        const bool atoms = s.directive == Kw::Material || s.directive == Kw::SkySphere;
+        if (s.directive == Kw::Material) head += cat({" ", text(s.nameTok)});
+        if (atoms) list = materialItems(s);
+        for (uint32_t k = 0; !atoms && k < s.count; ++k) {
             const DirectiveItem& item = ast_.items[s.first + k];
             if (item.flag) {
                 list.push_back({{t_[item.nameTok].offset, endOf(item.nameTok)},

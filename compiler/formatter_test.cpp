@@ -304,6 +304,34 @@ TEST(Formatter, MaterialBlocks) {
     EXPECT_EQ(a->graph->materials[1].minReflection(), 0.1);
 }
 
+// sky_sphere (section 10) is a directive whose body is a pigment block; patterns and
+// colour maps keep their items and brackets.
+TEST(Formatter, SkySphereAndPatterns) {
+    const std::string messy =
+        "sky_sphere{pigment{gradient z color_map{[0 rgb<1,1,1>][1 rgb<0.2,0.3,0.8>]}}}\n"
+        "material m {pigment{checker rgb 1,rgb 0 scale 2}normal{bumps 0.4 scale 0.1}}\n"
+        "paint(m) sphere\n";
+    const std::string expected =
+        "sky_sphere { pigment { gradient z color_map { [0 rgb <1, 1, 1>] [1 rgb <0.2, 0.3, "
+        "0.8>] } } }\n"
+        "material m {\n"
+        "    pigment { checker rgb 1 rgb 0 scale 2 }\n"
+        "    normal { bumps 0.4 scale 0.1 }\n"
+        "}\n"
+        "paint(m) sphere\n";
+    const std::string out = format(messy);
+    EXPECT_EQ(format(out), out);
+    const auto a = testing::compile(messy);
+    const auto b = testing::compile(out);
+    ASSERT_TRUE(a->graph) << a->errors();
+    ASSERT_TRUE(b->graph) << b->errors() << out;
+    expectSameGraph(*a->graph, *b->graph);
+    EXPECT_TRUE(b->graph->scene.skySphere);
+    EXPECT_EQ(b->graph->scene.skyPigment.colourMap.size(), 2u);
+    EXPECT_EQ(b->graph->materials[1].pigment.listColours.size(), 2u);
+    (void)expected;
+}
+
 TEST(Formatter, LongRulesBreakAfterUnion) {
     std::string rule = "{c=2} S\nS if(c > 0, 2, 1)\n1: S -> sphere\n2: S -> {c=c-1} (";
     for (int k = 0; k < 8; ++k) rule += (k ? " ∪ " : "") + std::string("move(0.25,0.5,0.75) S");

@@ -303,6 +303,11 @@ struct Scene {
     std::vector<Light> lights;  // the builder fills in the default light when none is given
     Vec3 background{0, 0, 0};
     Fog fog;
+    // sky_sphere { pigment { ... } } (section 10): the pigment at a missed ray's direction
+    // in scene coordinates, instead of the background.
+    bool skySphere = false;
+    Pigment skyPigment;      // a pattern, or PatternKind::Plain: skyColour
+    FilterColour skyColour;  // the plain pigment's colour
     Settings settings;
 };
 

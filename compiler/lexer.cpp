@@ -49,6 +49,7 @@ constexpr KeywordEntry kKeywords[] = {
     {"light", Kw::Light},
     {"background", Kw::Background},
     {"material", Kw::Material},
+    {"sky_sphere", Kw::SkySphere},
     {"settings", Kw::Settings},
     {"fog", Kw::Fog},
     {"paint", Kw::Paint},
@@ -443,7 +444,8 @@ class Scanner {
 bool isDirectiveKeyword(const Token& t) {
     return t.kind == Tok::Keyword &&
            (t.kw == Kw::Camera || t.kw == Kw::Light || t.kw == Kw::Background ||
-            t.kw == Kw::Material || t.kw == Kw::Settings || t.kw == Kw::Fog);
+            t.kw == Kw::Material || t.kw == Kw::Settings || t.kw == Kw::Fog ||
+            t.kw == Kw::SkySphere);
 }
 
 // Whether a statement (or an item inside braces) may end after this token.

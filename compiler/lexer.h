@@ -85,6 +85,7 @@ enum class Kw : uint8_t {
     Material,
     Settings,
     Fog,
+    SkySphere,
     // CSG
     Paint,
     Move,

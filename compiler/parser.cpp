@@ -115,7 +115,7 @@ bool isFunction(Kw k) {
     return k == Kw::If || k == Kw::Rand || k == Kw::Choose || (k >= Kw::Sin && k <= Kw::Clamp);
 }
 bool isDirective(Kw k) {
-    return k >= Kw::Camera && k <= Kw::Fog;
+    return k >= Kw::Camera && k <= Kw::SkySphere;
 }
 
 const int kAdditive = binaryPrecedence(Tok::Plus, false);
@@ -374,7 +374,7 @@ class Parser {
     }
 
     // directive -> ('camera' | 'light' | 'settings') block | 'background' vector
-    //            | 'material' IDENT block
+    //            | 'material' IDENT block | 'sky_sphere' block
     void directive() {
         Stmt s;
         s.kind = StmtKind::Directive;
@@ -390,8 +390,8 @@ class Parser {
                                      describe(src_, tok())));
             vector(item);
             items.push_back(item);
-        } else if (s.directive == Kw::Material) {
-            s.nameTok = name("a material");
+        } else if (s.directive == Kw::Material || s.directive == Kw::SkySphere) {
+            if (s.directive == Kw::Material) s.nameTok = name("a material");
             if (!at(Tok::LBrace))
                 fail(p_, fmt::format("expected '{{', found {}", describe(src_, tok())));
             const Atom body = atom();

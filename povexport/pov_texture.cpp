@@ -48,9 +48,11 @@ std::string modifiers(const PatternSpec& s) {
 }  // namespace
 
 std::string povPigment(const Material& m) {
-    const Pigment& p = m.pigment;
-    if (p.pattern.kind == PatternKind::Plain)
-        return fmt::format("pigment {{ {} }}", colour(FilterColour{m.color, m.filter, m.transmit}));
+    return povPigment(m.pigment, FilterColour{m.color, m.filter, m.transmit});
+}
+
+std::string povPigment(const Pigment& p, const FilterColour& plain) {
+    if (p.pattern.kind == PatternKind::Plain) return fmt::format("pigment {{ {} }}", colour(plain));
     std::string out =
         fmt::format("pigment {{ {}", p.pattern.spotted ? "spotted" : patternName(p.pattern.kind));
     if (p.pattern.kind == PatternKind::Gradient) out += fmt::format(" {}", vec(p.pattern.gradient));

@@ -12,6 +12,9 @@ namespace pcsg {
 // `pigment { ... }` of material m.
 std::string povPigment(const Material& m);
 
+// `pigment { ... }` of a pigment whose plain colour is `plain`.
+std::string povPigment(const Pigment& p, const FilterColour& plain);
+
 // ` normal { ... }` (with its leading blank) of material m, or "" without a normal pattern.
 std::string povNormal(const Material& m);
 

@@ -298,7 +298,10 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
     if (g.scene.fog.enabled) o.put("{}\n", povFog(g.scene.fog));
     o.put("background {{ color rgb ");
     o.vec(g.scene.background);
-    o.put(" }}\n\n");
+    o.put(" }}\n");
+    if (g.scene.skySphere)
+        o.put("sky_sphere {{ {} }}\n", povPigment(g.scene.skyPigment, g.scene.skyColour));
+    o.put("\n");
 
     // Materials: materials[0] is the default (white, POV-Ray's finish defaults).
     const size_t count = std::max<size_t>(g.materials.size(), 1);

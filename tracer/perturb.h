@@ -12,7 +12,8 @@
 namespace pcsg::tracer {
 
 // The perturbed normal (unit length) for facing normal `n` (unit length). The hit must be
-// painted with its paint frame's map (SurfaceHit::paintMap).
+// painted with its paint frame's map (SurfaceHit::paintMap), and no other ray may have
+// been traced by that tracer since: shading perturbs right after the hit.
 Vec3 perturbedNormal(const NormalSpec& spec, const SurfaceHit& hit, const Vec3& n);
 
 }  // namespace pcsg::tracer

@@ -13,6 +13,12 @@ FilterColour pigmentAt(const Pigment& p, const Vec3& point) {
     return colourMapLookup(defaultColourMap(mapOf), v);  // spotted: the grey map
 }
 
+Vec3 skyColour(const Scene& scene, const Vec3& dir) {
+    if (!scene.skySphere) return scene.background;
+    if (scene.skyPigment.pattern.kind == PatternKind::Plain) return scene.skyColour.rgb;
+    return pigmentAt(scene.skyPigment, normalize(dir)).rgb;
+}
+
 FilterColour pigmentColour(const Material& m, const SurfaceHit& hit) {
     if (m.pigment.pattern.kind == PatternKind::Plain || !hit.painted)
         return FilterColour{m.color, m.filter, m.transmit};

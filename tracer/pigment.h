@@ -10,6 +10,10 @@ namespace pcsg::tracer {
 
 FilterColour pigmentColour(const Material& m, const SurfaceHit& hit);
 
+// What a ray that meets nothing sees: the sky_sphere's pigment at its direction (scene
+// coordinates, normalised), else the background.
+Vec3 skyColour(const Scene& scene, const Vec3& dir);
+
 // A pigment with a pattern at a point in its paint node's frame (also the sky_sphere's,
 // at a direction).
 FilterColour pigmentAt(const Pigment& p, const Vec3& point);

@@ -34,7 +34,8 @@ Vec3 Shader::trace(const TreeRay& ray, double weight, bool continued) {
     SurfaceHit hit;
     const bool found =
         tracer_.firstHit(ray.origin, ray.dir, C::kMinIsectDepth, C::kMaxDistance, hit);
-    const Vec3 behind = found ? shadeHit(ray, hit, weight, continued) : g_.scene.background;
+    const Vec3 behind =
+        found ? shadeHit(ray, hit, weight, continued) : skyColour(g_.scene, ray.dir);
     // Fog (fog.h) on the stretch the ray travelled through the air: add + attenuation x
     // the colour behind; rays inside a solid are not fogged.
     if (!g_.scene.fog.enabled || !ray.inside.empty()) return behind;

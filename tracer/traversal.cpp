@@ -189,7 +189,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     if (out.painted) {
         const LocalRay& p = paintRays_[hit.paint - 1];
         out.paintPoint = p.o + p.d * hit.t;
-        if (scene_.paintMaps) out.paintMap = paintMaps_[hit.paint - 1];
+        if (scene_.paintMaps) out.paintMap = &paintMaps_[hit.paint - 1];
     }
     return true;
 }

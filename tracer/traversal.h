@@ -67,8 +67,9 @@ struct SurfaceHit {
     bool painted = false;
     Vec3 paintPoint;
     // Materials with a normal pattern (TraceScene::kPaintMap): the map of points from the
-    // world into the paint node's frame.
-    Affine paintMap;
+    // world into the paint node's frame, owned by the tracer and valid until its next
+    // walk (a pointer, so that rays of scenes without patterns carry no matrix).
+    const Affine* paintMap = nullptr;
 };
 
 // The graph with everything the walk precomputes once: its semantics (with the fused
