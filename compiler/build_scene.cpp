@@ -133,8 +133,7 @@ bool DirectiveReader::oneValue(const DirectiveItem& item) {
 // Whether a flag item (`spotlight`) stands alone; reports a value after it.
 bool DirectiveReader::flag(const DirectiveItem& item) {
     if (!item.flag)
-        ctx_.error(item.nameTok, fmt::format("'{}' takes no value",
-                                             clip(ctx_.text(item.nameTok))));
+        ctx_.error(item.nameTok, fmt::format("'{}' takes no value", clip(ctx_.text(item.nameTok))));
     return item.flag;
 }
 
@@ -287,10 +286,10 @@ std::optional<double> DirectiveReader::constValue(uint32_t e, const char* what) 
 // area_light <axis1>, <axis2>, size1, size2: two vectors, then two whole numbers >= 1.
 void DirectiveReader::areaLight(Light& l, const DirectiveItem& item) {
     const DirectiveItem* v = &item;
-    if (item.flag || item.more != 3 || !v[0].vector || !v[1].vector || v[2].vector ||
-        v[3].vector) {
-        ctx_.error(item.nameTok, "'area_light' takes <axis1>, <axis2>, size1, size2 (two "
-                                 "vectors and two whole numbers)");
+    if (item.flag || item.more != 3 || !v[0].vector || !v[1].vector || v[2].vector || v[3].vector) {
+        ctx_.error(item.nameTok,
+                   "'area_light' takes <axis1>, <axis2>, size1, size2 (two "
+                   "vectors and two whole numbers)");
         return;
     }
     Vec3 axes[2];
@@ -399,15 +398,16 @@ void DirectiveReader::checkLight(const Stmt& s, const Light& l,
                                  const std::vector<std::string_view>& given) {
     const bool area = std::find(given.begin(), given.end(), "area_light") != given.end();
     for (std::string_view n : given) {
-        if (!l.spotlight && (n == "point_at" || n == "radius" || n == "falloff" ||
-                             n == "tightness"))
+        if (!l.spotlight &&
+            (n == "point_at" || n == "radius" || n == "falloff" || n == "tightness"))
             ctx_.error(s.tok, fmt::format("'{}' needs 'spotlight' in the same light", n));
         if (!area && (n == "adaptive" || n == "jitter" || n == "circular" || n == "orient"))
             ctx_.error(s.tok, fmt::format("'{}' needs 'area_light' in the same light", n));
     }
     if (l.spotlight && l.shadowless)
-        ctx_.error(s.tok, "a light cannot be both 'spotlight' and 'shadowless' (POV-Ray 3.7 "
-                          "makes a shadowless light a fill light, which has no cone)");
+        ctx_.error(s.tok,
+                   "a light cannot be both 'spotlight' and 'shadowless' (POV-Ray 3.7 "
+                   "makes a shadowless light a fill light, which has no cone)");
     if (l.circular && (l.size1 <= 1 || l.size2 <= 1))
         ctx_.error(s.tok, "a 'circular' area_light needs sizes greater than 1");
 }

@@ -234,8 +234,8 @@ struct Light {
     // area_light <axis1>, <axis2>, size1, size2 (size1 * size2 > 1 makes it an area light)
     Vec3 axis1{0, 0, 0}, axis2{0, 0, 0};
     int size1 = 1, size2 = 1;
-    int adaptive = 100;   // POV-Ray's default: subdivide to the full grid
-    bool jitter = false;  // rendered with a fixed pseudo-random jitter; not reproducible in POV
+    int adaptive = 100;     // POV-Ray's default: subdivide to the full grid
+    bool jitter = false;    // rendered with a fixed pseudo-random jitter; not reproducible in POV
     bool circular = false;  // the grid's square shells mapped to circles
     bool orient = false;    // the axes turned to face each lit point
     bool areaLight() const { return size1 * size2 > 1; }

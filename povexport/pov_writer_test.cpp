@@ -171,8 +171,7 @@ TEST(PovWriter, FilterTransmitFadeAndTraceLevel) {
     EXPECT_NE(s.find("global_settings { assumed_gamma 1.0 max_trace_level 9 adc_bailout 0.01 }"),
               std::string::npos)
         << s;
-    EXPECT_NE(s.find("pigment { color rgbft <0.5,1,0.25,0.75,0.125> }"), std::string::npos)
-        << s;
+    EXPECT_NE(s.find("pigment { color rgbft <0.5,1,0.25,0.75,0.125> }"), std::string::npos) << s;
     EXPECT_NE(s.find("interior { ior 1.33 fade_distance 2 fade_power 1001 fade_color rgb "
                      "<0.5,0,0> } }"),
               std::string::npos)

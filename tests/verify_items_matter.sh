@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # A hand-written POV-Ray probe agrees with the native render, and stops agreeing when any
-# one item of its noise patterns or normals changes: the comparison sees each of them, so
-# the verify_hand_written_* test of the probe can fail for each.
-#   verify_noise_items_matter.sh PCSG SCENE.pcsg SCENE.pov SED-CHANGE...
+# one item in its POV-Ray text changes: the comparison sees each of them, so the
+# verify_hand_written_* test of the probe can fail for each formula (finish, transparency,
+# noise patterns, normals: tests/CMakeLists.txt lists the changes).
+#   verify_items_matter.sh PCSG SCENE.pcsg SCENE.pov SED-CHANGE...
 # VERIFY_OPTS adds options to every verify (the thresholds the probe's own test uses).
 set -euo pipefail
 pcsg=$1 scene=$2 pov=$3
