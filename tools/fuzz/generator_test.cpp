@@ -15,9 +15,12 @@
 #include "eval.h"
 #include "expander.h"
 #include "formatter.h"
+#include "same_graph_test_util.h"
 
 namespace pcsg::fuzz {
 namespace {
+
+using pcsg::testing::expectSameGraph;
 
 TEST(FuzzRng, IsAFixedSequenceOfTheSeed) {
     // xoshiro256** from splitmix64: the first outputs are a property of the algorithm,
@@ -49,27 +52,6 @@ TEST(FuzzGenerator, SameSeedSameTextOtherSeedOtherText) {
         EXPECT_EQ(a, generateSystem(seed));
         EXPECT_NE(a, generateSystem(seed + 1));
     }
-}
-
-// The graphs agree in their structure and code (not in source positions).
-void expectSameGraph(const Graph& a, const Graph& b) {
-    ASSERT_EQ(a.nodes.size(), b.nodes.size());
-    for (size_t k = 0; k < a.nodes.size(); ++k) {
-        EXPECT_EQ(a.nodes[k].kind, b.nodes[k].kind) << k;
-        EXPECT_EQ(a.nodes[k].payload, b.nodes[k].payload) << k;
-        EXPECT_EQ(a.nodes[k].firstChild, b.nodes[k].firstChild) << k;
-        EXPECT_EQ(a.nodes[k].childCount, b.nodes[k].childCount) << k;
-    }
-    EXPECT_EQ(a.edges, b.edges);
-    ASSERT_EQ(a.code.size(), b.code.size());
-    for (size_t k = 0; k < a.code.size(); ++k) {
-        EXPECT_EQ(a.code[k].op, b.code[k].op) << k;
-        EXPECT_EQ(a.code[k].imm, b.code[k].imm) << k;
-    }
-    ASSERT_EQ(a.primitives.size(), b.primitives.size());
-    for (size_t k = 0; k < a.primitives.size(); ++k)
-        EXPECT_EQ(a.primitives[k].values, b.primitives[k].values) << k;
-    EXPECT_EQ(a.slotNames, b.slotNames);
 }
 
 TEST(FuzzGenerator, EverySystemCompilesExpandsAndFormats) {
