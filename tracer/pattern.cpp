@@ -22,21 +22,6 @@ const PatternDefaults& defaultsOf(PatternKind k) {
     return table[static_cast<size_t>(k)];
 }
 
-bool isNoisePattern(PatternKind k) {
-    switch (k) {
-        case PatternKind::Bozo:
-        case PatternKind::Granite:
-        case PatternKind::Wood:
-        case PatternKind::Marble:
-        case PatternKind::Agate:
-        case PatternKind::Wrinkles:
-        case PatternKind::Dents:
-            return true;
-        default:
-            return false;
-    }
-}
-
 // checker: the parity of the unit cube the point is in.
 double checker(const Vec3& p) {
     const auto sum = static_cast<long long>(
@@ -140,9 +125,9 @@ double applyFrequencyPhase(const PatternSpec& s, double value) {
 
 double patternValue(const PatternSpec& s, const Vec3& paintPoint) {
     Vec3 p = s.transformed ? s.toPattern.point(paintPoint) : paintPoint;
-    const bool noisy = isNoisePattern(s.kind);
-    if (s.turbulence.on() && !(noisy && defaultsOf(s.kind).turbulenceInside))
-        p = turbulenceWarp(s.turbulence, p);
+    // The seven noise patterns apply their turbulence themselves (noise_patterns.h).
+    const bool noisy = defaultsOf(s.kind).turbulenceInside;
+    if (s.turbulence.on() && !noisy) p = turbulenceWarp(s.turbulence, p);
     if (isListPattern(s.kind)) return plainPatternValue(s, p);
     const double raw = noisy ? noisePatternValue(s, p) : plainPatternValue(s, p);
     return applyFrequencyPhase(s, raw);
