@@ -261,19 +261,6 @@ int runFuzz(FuzzOptions o) {
     return c.disagree.empty() ? 0 : 1;
 }
 
-// verify's thresholds, which are fuzz's defaults too.
-void addThresholdOptions(CLI::App* cmd, FuzzOptions& o) {
-    cmd->add_option("--pixel-threshold", o.thresholds.pixelOff,
-                    "As verify's: a pixel is off when a channel differs by more than this")
-        ->capture_default_str();
-    cmd->add_option("--max-off", o.thresholds.maxShareOff,
-                    "As verify's: agree only if at most this share of pixels is off")
-        ->capture_default_str();
-    cmd->add_option("--max-mean-error", o.thresholds.maxMeanError,
-                    "As verify's: agree only if the mean absolute error is at most this")
-        ->capture_default_str();
-}
-
 }  // namespace
 
 void addFuzzCommand(CLI::App& app, int& status) {
@@ -301,17 +288,7 @@ void addFuzzCommand(CLI::App& app, int& status) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", o->seedText,
                     "The campaign's seed, decimal or 0x hex (default: from the time; printed)");
-    cmd->add_option("--width", o->width, "Image width after reduction")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--height", o->height, "Image height after reduction")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--ss", o->ss, "Supersampling factor K, as verify's")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--threads", o->threads, "Threads for both renderers (default: all cores)")
-        ->check(CLI::NonNegativeNumber);
+    addImageOptions(cmd, *o);
     addThresholdOptions(cmd, *o);
     cmd->add_option("--out", o->outDir,
                     "Write the cases here (default: a temporary directory, kept only when there "

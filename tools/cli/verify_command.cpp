@@ -303,17 +303,7 @@ void addVerifyCommand(CLI::App& app, int& status) {
     cmd->add_option("scenes", o->scenes, "Scene files (.pcsg)");
     cmd->add_option("--all", o->allDir, "Verify every .pcsg file in this directory")
         ->check(CLI::ExistingDirectory);
-    cmd->add_option("--width", o->width, "Image width after reduction")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--height", o->height, "Image height after reduction")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--ss", o->ss, "Supersampling factor K: both render K*W x K*H")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--threads", o->threads, "Threads for both renderers (default: all cores)")
-        ->check(CLI::NonNegativeNumber);
+    addImageOptions(cmd, *o);
     cmd->add_option("--report", o->reportDir,
                     "Write an HTML report into this directory; open DIR/index.html");
     auto* clock = addClockOption(cmd, o->clock);
@@ -332,15 +322,7 @@ void addVerifyCommand(CLI::App& app, int& status) {
     cmd->add_option("--pov", o->povFile,
                     "Render this POV-Ray file instead of exporting the scene (a hand-written "
                     "scene to compare with); POV-Ray gets each frame's clock as +K");
-    cmd->add_option("--pixel-threshold", o->thresholds.pixelOff,
-                    "A pixel is off when a channel differs by more than this (0..1)")
-        ->capture_default_str();
-    cmd->add_option("--max-off", o->thresholds.maxShareOff,
-                    "Agree only if at most this share of pixels is off")
-        ->capture_default_str();
-    cmd->add_option("--max-mean-error", o->thresholds.maxMeanError,
-                    "Agree only if the mean absolute error is at most this")
-        ->capture_default_str();
+    addThresholdOptions(cmd, *o);
     cmd->add_flag("--json", o->json, "Print the results as JSON");
     cmd->add_flag("--keep", o->keep, "Keep the images (in a temporary directory) without --report");
     cmd->callback([o, &status] { status = runVerify(*o); });

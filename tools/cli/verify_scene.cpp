@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <fstream>
 
 #include "image_helper.h"
@@ -155,6 +156,32 @@ SceneResult verifyScene(const std::string& scene, const std::string& dir,
     if (pov.empty() || !renderPovraySide(r, o, pov, work)) return r;
     compareSides(r, o, work);
     return r;
+}
+
+void addImageOptions(CLI::App* cmd, SceneVerifyOptions& o) {
+    cmd->add_option("--width", o.width, "Image width after reduction")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--height", o.height, "Image height after reduction")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--ss", o.ss, "Supersampling factor K: both render K*W x K*H")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--threads", o.threads, "Threads for both renderers (default: all cores)")
+        ->check(CLI::NonNegativeNumber);
+}
+
+void addThresholdOptions(CLI::App* cmd, SceneVerifyOptions& o) {
+    cmd->add_option("--pixel-threshold", o.thresholds.pixelOff,
+                    "A pixel is off when a channel differs by more than this (0..1)")
+        ->capture_default_str();
+    cmd->add_option("--max-off", o.thresholds.maxShareOff,
+                    "Agree only if at most this share of pixels is off")
+        ->capture_default_str();
+    cmd->add_option("--max-mean-error", o.thresholds.maxMeanError,
+                    "Agree only if the mean absolute error is at most this")
+        ->capture_default_str();
 }
 
 }  // namespace pcsg::tools

@@ -11,6 +11,10 @@
 
 #include "verify_result.h"
 
+namespace CLI {
+class App;
+}
+
 namespace pcsg::tools {
 
 struct SceneVerifyOptions : VerifySettings {
@@ -22,6 +26,12 @@ struct SceneVerifyOptions : VerifySettings {
     // (none for a still at clock 0).
     std::vector<std::string> clockArgs() const;
 };
+
+// The options `pcsg verify` and `pcsg fuzz` share, with verify's defaults: --width,
+// --height, --ss and --threads; and the thresholds --pixel-threshold, --max-off and
+// --max-mean-error.
+void addImageOptions(CLI::App* cmd, SceneVerifyOptions& o);
+void addThresholdOptions(CLI::App* cmd, SceneVerifyOptions& o);
 
 // The scene's text for the report (up to 256 KB); empty when it cannot be read.
 std::string readSource(const std::string& scene);
