@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -23,6 +24,35 @@ std::string frameFileName(const std::string& output, int frame, int frames) {
     const std::string name =
         fmt::format("{}{:0{}}{}", path.stem().string(), frame, width, path.extension().string());
     return (path.parent_path() / name).string();
+}
+
+bool FrameBoundsChoice::ownBoxes() const {
+    switch (mode_) {
+        case Mode::On:
+            return true;
+        case Mode::Off:
+            return false;
+        case Mode::Auto:
+            break;
+    }
+    return std::min(share_[0], share_[1]) < kShare || sinceOwn_ + 1 >= kRetry;
+}
+
+void FrameBoundsChoice::frameDone(bool own, double boundsSeconds, double renderSeconds) {
+    if (!own) {
+        ++sinceOwn_;
+        return;
+    }
+    sinceOwn_ = 0;
+    share_[1] = share_[0];
+    share_[0] = renderSeconds > 0 ? boundsSeconds / renderSeconds : kShare;
+}
+
+std::optional<FrameBoundsChoice::Mode> frameBoundsMode(const std::string& text) {
+    if (text == "auto") return FrameBoundsChoice::Mode::Auto;
+    if (text == "on") return FrameBoundsChoice::Mode::On;
+    if (text == "off") return FrameBoundsChoice::Mode::Off;
+    return std::nullopt;
 }
 
 namespace {

@@ -23,6 +23,36 @@ double frameClock(const FramePlan& plan, int frame);
 // extension ("out.png", 24 frames: "out01.png" ... "out24.png"; 3 frames: "out1.png").
 std::string frameFileName(const std::string& output, int frame, int frames);
 
+// Whether each frame of a sequence computes its own hyper-bounding boxes (tighter than
+// the boxes of the whole clock range, which the sequence computes once): --frame-bounds
+// on, off, or auto. Auto computes them while they took under 2% of the frame's render
+// time, judged by the cheaper of the last two frames that computed their own (so that
+// one slow measurement, a thread descheduled on a loaded machine, does not switch them
+// off), and re-measures one frame in every kRetry while they are off (a growing scene's
+// frames get dearer as it grows, and its boxes pay again). The pixels are the same
+// either way: only the time depends on this choice.
+class FrameBoundsChoice {
+  public:
+    enum class Mode { Auto, On, Off };
+    static constexpr double kShare = 0.02;
+    static constexpr int kRetry = 8;
+
+    explicit FrameBoundsChoice(Mode mode) : mode_(mode) {}
+    // Whether the next frame computes its own boxes.
+    bool ownBoxes() const;
+    // A frame was rendered: with its own boxes (which took boundsSeconds) or with the
+    // range's; renderSeconds without the boxes.
+    void frameDone(bool own, double boundsSeconds, double renderSeconds);
+
+  private:
+    Mode mode_;
+    double share_[2] = {0, 0};  // the last two own frames' boxes / render time
+    int sinceOwn_ = 0;          // frames rendered with the range's boxes since the last own
+};
+
+// "on", "off" or "auto" (the --frame-bounds values); nothing otherwise.
+std::optional<FrameBoundsChoice::Mode> frameBoundsMode(const std::string& text);
+
 // "A,B": two finite numbers, A <= B. Nothing, with `error` set, otherwise.
 std::optional<std::pair<double, double>> parseClockRange(const std::string& text,
                                                          std::string& error);

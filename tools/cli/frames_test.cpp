@@ -128,6 +128,46 @@ TEST(Frames, RangeBoxesAndFrameBoxesGiveTheSamePixels) {
     }
 }
 
+// --frame-bounds auto: one slow measurement of a frame's boxes (a descheduled thread)
+// does not turn them off for the rest of the sequence, as it once did at frame 22 of
+// the growing tree's 48 under load; boxes that do not pay are turned off, and measured
+// again one frame in kRetry, so that they come back once the frames have grown dear.
+TEST(Frames, FrameBoxesAreChosenByTheirShareOfTheRender) {
+    using Choice = FrameBoundsChoice;
+    Choice on(Choice::Mode::On), off(Choice::Mode::Off);
+    on.frameDone(true, 1, 1);
+    off.frameDone(false, 0, 1);
+    EXPECT_TRUE(on.ownBoxes());
+    EXPECT_FALSE(off.ownBoxes());
+
+    Choice spike(Choice::Mode::Auto);
+    EXPECT_TRUE(spike.ownBoxes());
+    spike.frameDone(true, 0.0003, 1.0);
+    spike.frameDone(true, 0.024, 1.0);  // 2.4%: one slow measurement
+    EXPECT_TRUE(spike.ownBoxes());
+    spike.frameDone(true, 0.0003, 1.0);
+    spike.frameDone(true, 0.0003, 1.0);
+    EXPECT_TRUE(spike.ownBoxes());
+
+    Choice cheap(Choice::Mode::Auto);  // frames so quick that their boxes do not pay
+    cheap.frameDone(true, 0.001, 0.01);
+    EXPECT_TRUE(cheap.ownBoxes());  // one measurement is not enough
+    cheap.frameDone(true, 0.001, 0.01);
+    int own = 0;
+    for (int f = 0; f < 2 * Choice::kRetry; ++f) {
+        const bool mine = cheap.ownBoxes();
+        own += mine;
+        cheap.frameDone(mine, 0.001, 0.01);
+    }
+    EXPECT_EQ(own, 2);  // one frame in kRetry re-measures
+    // The frames have grown dear: the boxes pay again after two measurements.
+    for (int f = 0; f < 2 * Choice::kRetry && !cheap.ownBoxes(); ++f) cheap.frameDone(false, 0, 1);
+    cheap.frameDone(true, 0.001, 1.0);
+    EXPECT_TRUE(cheap.ownBoxes());
+    cheap.frameDone(true, 0.001, 1.0);
+    EXPECT_TRUE(cheap.ownBoxes());
+}
+
 // A frame's pixels are released once written: the peak RSS of a sequence does not grow
 // with its length (it once kept every frame's image to the end, 177 MB for 48 frames of
 // 640x480).

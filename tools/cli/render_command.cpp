@@ -328,12 +328,12 @@ struct FrameFigures {
 
 // The hyper-bounding boxes of a sequence (docs/language.md section 11): computed once
 // for the clock range of the frames rendered, with `clock` and `frame` intervals. A frame
-// computes its own, tighter boxes too (they cull more) when that pays: always with
-// --frame-bounds on, never with off, and with auto while its boxes took under 2% of its
-// render time. The image is the same either way.
+// computes its own, tighter boxes too (they cull more) when FrameBoundsChoice (frames.h)
+// says so. The image is the same either way.
 class SequenceBounds {
   public:
-    SequenceBounds(const Graph& g, const FramePlan& plan, const std::string& mode) : mode_(mode) {
+    SequenceBounds(const Graph& g, const FramePlan& plan, const std::string& mode)
+        : choice_(frameBoundsMode(mode).value_or(FrameBoundsChoice::Mode::Auto)) {
         const double a = frameClock(plan, plan.first), b = frameClock(plan, plan.last);
         tracer::BoundsOptions bo;
         bo.time = TimeRange{std::min(a, b), std::max(a, b), plan.first, plan.last};
@@ -347,20 +347,19 @@ class SequenceBounds {
     }
     // The boxes for the next frame: the range's, or null (the frame computes its own).
     std::shared_ptr<const tracer::Bounds> next() const {
-        if (!range_ || mode_ == "on" || (mode_ == "auto" && tighten_)) return nullptr;
+        if (!range_ || choice_.ownBoxes()) return nullptr;
         return range_;
     }
     // What the last frame cost: its own boxes and its render.
     void update(const tracer::RenderResult& r, bool ownBounds) {
-        if (ownBounds) tighten_ = r.boundsSeconds < 0.02 * r.seconds;
+        choice_.frameDone(ownBounds, r.boundsSeconds, r.seconds);
     }
     double seconds() const { return seconds_; }
 
   private:
-    std::string mode_;
+    FrameBoundsChoice choice_;
     std::shared_ptr<const tracer::Bounds> range_;
     double seconds_ = 0;
-    bool tighten_ = true;
 };
 
 // Sets frame f's time, renders it and writes its file, as a still at that clock would be.
