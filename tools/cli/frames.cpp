@@ -9,6 +9,10 @@
 #include <cstdlib>
 #include <filesystem>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 namespace pcsg::tools {
 
 double frameClock(const FramePlan& p, int frame) {
@@ -46,6 +50,12 @@ void FrameBoundsChoice::frameDone(bool own, double boundsSeconds, double renderS
     sinceOwn_ = 0;
     share_[1] = share_[0];
     share_[0] = renderSeconds > 0 ? boundsSeconds / renderSeconds : kShare;
+}
+
+void useOneMallocArena() {
+#if defined(__GLIBC__)
+    mallopt(M_ARENA_MAX, 1);
+#endif
 }
 
 std::optional<FrameBoundsChoice::Mode> frameBoundsMode(const std::string& text) {
