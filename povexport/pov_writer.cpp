@@ -215,10 +215,15 @@ std::string commentSafe(const std::string& s) {
 }
 
 // Whether materials are written as POV-Ray `material { texture interior }`: when any has
-// an interior; else as textures, as before interiors existed.
+// an interior or may let light through; else as textures, as before interiors existed.
+// Wrapped, every material has its interior (ior 1 where none was given), so that each
+// `material { }` written, one per paint node instance of the tree, is an object with its
+// own interior, as the tracer's interiors are (tracer/transparency.h): POV-Ray gives an
+// object whose material has no interior its parent's, and the root's to all objects when
+// no material has one.
 bool materialWrapped(const Graph& g) {
     for (const Material& m : g.materials)
-        if (m.interior) return true;
+        if (m.interior || m.mayLetLightThrough()) return true;
     return false;
 }
 
@@ -311,7 +316,7 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
         o.put("#declare M{} = {}", i, wrapped ? "material { texture { " : "texture { ");
         putTexture(o, m);
         o.put(" }}");
-        if (wrapped && m.interior) putInterior(o, m);
+        if (wrapped) putInterior(o, m);
         if (wrapped) o.put(" }}");
         if (!m.name.empty()) o.put("  // {}", commentSafe(m.name));
         o.put("\n");

@@ -110,8 +110,9 @@ TEST(PovWriter, EachMaterialIsDeclaredOnceAsATexture) {
 }
 
 // Section 10's finish items are written where they differ from POV-Ray's defaults; a
-// material with an interior makes every material a POV-Ray `material`, so that the
-// interior travels with its texture.
+// material with an interior makes every material a POV-Ray `material` with an interior
+// (ior 1 where the scene gives none), so that each use of one is an object with its own
+// interior, as the tracer's interiors are.
 TEST(PovWriter, FinishItemsAndInteriors) {
     Graph g;
     defaultScene(g);
@@ -133,9 +134,11 @@ TEST(PovWriter, FinishItemsAndInteriors) {
     g.axiom =
         g.addOperator(CsgOp::Union, {paint(g, 1, primitive(g, P::Sphere)), primitive(g, P::Cube)});
     const std::string s = exportText(g);
-    EXPECT_NE(s.find("#declare M0 = material { texture { pigment { color rgb <1,1,1> } finish { "
-                     "ambient 0.1 diffuse 0.6 phong 0 phong_size 40 reflection 0 } } }"),
-              std::string::npos)
+    EXPECT_NE(
+        s.find(
+            "#declare M0 = material { texture { pigment { color rgb <1,1,1> } finish { "
+            "ambient 0.1 diffuse 0.6 phong 0 phong_size 40 reflection 0 } } interior { ior 1 } }"),
+        std::string::npos)
         << s;
     EXPECT_NE(s.find("#declare M1 = material { texture { pigment { color rgb <1,1,1> } finish { "
                      "ambient 0.1 diffuse 0.6 brilliance 2 phong 0 phong_size 40 specular 0.5 "
@@ -176,6 +179,24 @@ TEST(PovWriter, FilterTransmitFadeAndTraceLevel) {
                      "<0.5,0,0> } }"),
               std::string::npos)
         << s;
+}
+
+// A material that lets light through, without an interior, makes every material a POV-Ray
+// `material` with an interior too: without, POV-Ray would give all objects the root's one
+// interior.
+TEST(PovWriter, TransparencyGivesEveryMaterialAnInterior) {
+    Graph g;
+    defaultScene(g);
+    Material veil;
+    veil.transmit = 0.5;
+    g.materials.push_back(veil);
+    g.axiom =
+        g.addOperator(CsgOp::Union, {paint(g, 1, primitive(g, P::Sphere)), primitive(g, P::Cube)});
+    const std::string s = exportText(g);
+    EXPECT_EQ(occurrences(s, "interior { ior 1 } }"), 2u) << s;
+    EXPECT_EQ(occurrences(s, "material{M1}"), 1u);
+    EXPECT_EQ(occurrences(s, "material{M0}"), 1u);
+    EXPECT_EQ(occurrences(s, "texture{M"), 0u);
 }
 
 // A paint node's material is one texture where the paint stands (docs/language.md
