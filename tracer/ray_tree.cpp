@@ -19,6 +19,7 @@ struct Shader::Surface {
     int level;  // the trace level of the ray that hit (the camera ray's hit: 1)
     double t;
     Vec3 p, n;
+    Vec3 raw;           // the surface's own normal facing the ray (n before a normal pattern)
     Interior interior;  // its object's (transparency.h), whose material is m
     const Material& m;
     FilterColour pigment;
@@ -49,6 +50,7 @@ Vec3 Shader::shadeHit(const TreeRay& ray, const SurfaceHit& hit, double weight, 
     Vec3 n = normalize(hit.normal);
     if (!isFinite(n)) n = -ray.dir;  // degenerate normal (apex of a cone): face the viewer
     if (dot(n, ray.dir) > 0) n = -n;
+    const Vec3 raw = n;
     const uint32_t mi = hit.material < g_.materials.size() ? hit.material : 0;
     const Material& m = g_.materials[mi];
     if (m.normal.kind != NormalKind::None && hit.painted) n = perturbedNormal(m.normal, hit, n);
@@ -61,6 +63,7 @@ Vec3 Shader::shadeHit(const TreeRay& ray, const SurfaceHit& hit, double weight, 
         hit.t,
         ray.origin + ray.dir * hit.t,
         n,
+        raw,
         interior,
         m,
         pigment,
@@ -109,8 +112,20 @@ Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection)
 }
 
 // The ray mirrored at the surface (ComputeReflection), in the incoming ray's interiors.
+// A normal pattern may tilt the normal so far that the mirrored ray goes into the surface
+// (below its own normal); POV-Ray then mirrors it at the surface's own normal instead
+// when it also goes against the tilted one, else mirrors it once more at the own normal
+// (its "reflection bugfix" of 1998).
 Vec3 Shader::reflected(const Surface& s, double weight) {
-    const Vec3 d = normalize(s.ray.dir - s.n * (2 * dot(s.ray.dir, s.n)));
+    Vec3 d = s.ray.dir - s.n * (2 * dot(s.ray.dir, s.n));
+    const double below = dot(d, s.raw);
+    if (below < 0) {
+        if (dot(d, s.n) < 0)
+            d = s.ray.dir - s.raw * (2 * dot(s.ray.dir, s.raw));
+        else
+            d = d + s.raw * (-2 * below);
+    }
+    d = normalize(d);
     return trace(TreeRay{s.p, d, s.level, s.ray.inside, s.ray.straight}, weight, false);
 }
 
