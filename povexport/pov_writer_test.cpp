@@ -199,6 +199,28 @@ TEST(PovWriter, TransparencyGivesEveryMaterialAnInterior) {
     EXPECT_EQ(occurrences(s, "texture{M"), 0u);
 }
 
+// Below an intersection or difference, a union is written as POV-Ray's merge when some
+// material lets light through: the tracer's span lists have no surfaces inside the union
+// there, POV-Ray's union keeps them, and light passing through would show them. At the
+// top, the tracer's first hits see them too, and a union stays a union.
+TEST(PovWriter, AUnionInACutIsAMergeWhenLightPasses) {
+    for (const bool transparent : {false, true}) {
+        Graph g;
+        defaultScene(g);
+        Material glass;
+        glass.transmit = transparent ? 0.5 : 0;
+        g.materials.push_back(glass);
+        const NodeId u =
+            g.addOperator(CsgOp::Union, {primitive(g, P::Sphere), primitive(g, P::Cube)});
+        const NodeId cut =
+            g.addOperator(CsgOp::Difference, {paint(g, 1, u), primitive(g, P::Cylinder)});
+        g.axiom = g.addOperator(CsgOp::Union, {cut, primitive(g, P::Cone)});
+        const std::string s = exportText(g);
+        EXPECT_EQ(occurrences(s, "merge {"), transparent ? 1u : 0u) << s;
+        EXPECT_EQ(occurrences(s, "union {"), transparent ? 1u : 2u) << s;
+    }
+}
+
 // A paint node's material is one texture where the paint stands (docs/language.md
 // section 10): on the union it paints, not copied onto each primitive. An inner paint is
 // a texture of its own, which POV-Ray keeps (inner textures override outer), and the root
