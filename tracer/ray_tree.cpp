@@ -84,6 +84,14 @@ Vec3 Shader::shadeSurface(const Surface& s, double weight) {
     return colour;
 }
 
+namespace {
+// The normal n turned to face a ray in direction d: a normal pattern may have tilted the
+// normal away from the ray, and POV-Ray's ComputeRefraction refracts at it turned back.
+Vec3 facingRay(const Vec3& n, const Vec3& d) {
+    return dot(d, n) > 0 ? -n : n;
+}
+}  // namespace
+
 // The light through the surface (ComputeRefraction, TraceRefractionRay): a straight ray
 // between equal iors, a refracted one, or on total internal reflection the reflected ray.
 Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection) {
@@ -99,7 +107,7 @@ Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection)
     if (std::fabs(ior - 1.0) < C::kEpsilon) {
         next.straight = s.ray.straight + 1;
         light = trace(next, w, true);
-    } else if (const auto d = refractDirection(s.ray.dir, s.n, ior)) {
+    } else if (const auto d = refractDirection(s.ray.dir, facingRay(s.n, s.ray.dir), ior)) {
         next.dir = normalize(*d);
         light = trace(next, w, false);
     } else {
