@@ -77,6 +77,16 @@ size_t Graph::graphBytes() const {
     return b;
 }
 
+bool Material::mayLetLightThrough() const {
+    const auto through = [](const FilterColour& c) { return c.filter != 0 || c.transmit != 0; };
+    if (filter != 0 || transmit != 0) return true;
+    for (const FilterColour& c : pigment.listColours)
+        if (through(c)) return true;
+    for (const ColourMapEntry& e : pigment.colourMap)
+        if (through(e.colour)) return true;
+    return false;
+}
+
 std::string Graph::where(FileLoc loc) const {
     const std::string file = loc.file < files.size() ? files[loc.file] : std::string("<scene>");
     if (loc.line == 0) return file;

@@ -286,6 +286,9 @@ struct Material {
     NormalSpec normal{};  // NormalKind::None: the surface's own normal
 
     double minReflection() const { return reflectionRange ? reflectionMin : reflection; }
+    // Whether it may let light through: its plain colour or a colour of its pattern has a
+    // filter or transmit.
+    bool mayLetLightThrough() const;
 };
 inline constexpr uint8_t kMaterialFields = 16;
 

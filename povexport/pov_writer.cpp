@@ -214,11 +214,22 @@ std::string commentSafe(const std::string& s) {
     return out;
 }
 
+bool anyLetsLightThrough(const Graph& g) {
+    for (const Material& m : g.materials)
+        if (m.mayLetLightThrough()) return true;
+    return false;
+}
+
 // Whether materials are written as POV-Ray `material { texture interior }`: when any has
-// an interior; else as textures, as before interiors existed.
+// an interior or may let light through; else as textures, as before interiors existed.
+// Wrapped, every material has its interior (ior 1 where none was given), so that each
+// `material { }` written, one per paint node instance of the tree, is an object with its
+// own interior, as the tracer's interiors are (tracer/transparency.h): POV-Ray gives an
+// object whose material has no interior its parent's, and the root's to all objects when
+// no material has one.
 bool materialWrapped(const Graph& g) {
     for (const Material& m : g.materials)
-        if (m.interior) return true;
+        if (m.interior || m.mayLetLightThrough()) return true;
     return false;
 }
 
@@ -311,7 +322,7 @@ void putHeader(Out& o, const Graph& g, const ExpandedTree& t, const PovOptions& 
         o.put("#declare M{} = {}", i, wrapped ? "material { texture { " : "texture { ");
         putTexture(o, m);
         o.put(" }}");
-        if (wrapped && m.interior) putInterior(o, m);
+        if (wrapped) putInterior(o, m);
         if (wrapped) o.put(" }}");
         if (!m.name.empty()) o.put("  // {}", commentSafe(m.name));
         o.put("\n");
@@ -441,7 +452,8 @@ struct Item {
     std::vector<std::pair<size_t, size_t>> slices;  // a big group's sub-groups
     bool ownsMembers = false;  // this item pushed members[lo, hi) and pops them at the end
     Box box;
-    uint32_t texture = kNone;              // a group that replaces a union: the union's own texture
+    bool cut = false;          // below an intersection or difference (a union there is a merge)
+    uint32_t texture = kNone;  // a group that replaces a union: the union's own texture
     const Affine* textureFrame = nullptr;  // and its paint frame
 };
 
@@ -450,14 +462,15 @@ class TreeWriter {
     static constexpr size_t kMaxNesting = 256;  // deeper unions are flattened and regrouped
 
     TreeWriter(Out& o, const ExpandedTree& t, const PovOptions& opt, PovWriteStats& stats,
-               bool wrapped)
+               bool wrapped, bool merges)
         : o_(o),
           t_(t),
           opt_(opt),
           stats_(stats),
           boxes_(nodeBoxes(t)),
           maxChildren_(std::max<uint32_t>(opt.maxUnionChildren, 2)),
-          wrapped_(wrapped) {}
+          wrapped_(wrapped),
+          merges_(merges) {}
 
     void write(uint32_t root) {
         stack_.push_back(nodeItem(root));
@@ -465,11 +478,17 @@ class TreeWriter {
     }
 
   private:
-    Item nodeItem(uint32_t n) {
+    Item nodeItem(uint32_t n, bool cut = false) {
         Item it;
         it.node = n;
+        it.cut = cut;
         return it;
     }
+
+    // A union's keyword: `merge` below an intersection or difference, where the tracer's
+    // span lists have no surfaces inside the union (POV-Ray's union keeps them, which
+    // light passing through shows), when some material lets light through.
+    const char* unionWord(bool cut) const { return merges_ && cut ? "merge" : "union"; }
 
     std::string indent() const {
         return std::string(std::min<size_t>(stack_.size() - 1, 40) * 1, ' ');
@@ -497,11 +516,13 @@ class TreeWriter {
             return;
         }
         if (it.next == 0) {
-            o_.put("{}{} {{\n", indent(), csgOpName(node.op));
+            o_.put("{}{} {{\n", indent(),
+                   node.is(CsgOp::Union) ? unionWord(it.cut) : csgOpName(node.op));
         }
         if (it.next < node.count) {
             const uint32_t c = t_.childrenOf(it.node)[it.next++];
-            stack_.push_back(nodeItem(c));
+            const bool cut = it.cut || !node.is(CsgOp::Union);
+            stack_.push_back(nodeItem(c, cut));
             return;
         }
         const Box& b = boxes_[it.node];
@@ -529,6 +550,7 @@ class TreeWriter {
     // 19,000 nested braces.
     void regroupUnion(uint32_t n, bool deep) {
         const size_t lo = members_.size();
+        const bool cut = stack_.back().cut;
         if (deep)
             flattenUnion(n);
         else
@@ -536,6 +558,7 @@ class TreeWriter {
         stack_.pop_back();
         Item g;
         g.group = true;
+        g.cut = cut;
         g.lo = lo;
         g.hi = members_.size();
         g.ownsMembers = true;
@@ -551,23 +574,26 @@ class TreeWriter {
         if (it.next == 0) {
             if (n == 1 && it.texture == kNone) {
                 const uint32_t only = members_[it.lo];
-                finishGroup();
-                stack_.push_back(nodeItem(only));
+                const bool cut = it.cut;
+                finishGroup();  // pops `it`
+                stack_.push_back(nodeItem(only, cut));
                 return;
             }
             for (size_t i = it.lo; i < it.hi; ++i) it.box.extend(boxes_[members_[i]]);
             if (n > maxChildren_) split(it);
-            o_.put("{}union {{\n", indent());
+            o_.put("{}{} {{\n", indent(), unionWord(it.cut));
             ++stats_.groups;
         }
         const size_t parts = it.slices.empty() ? n : it.slices.size();
         if (it.next < parts) {
             const uint32_t i = it.next++;
+            const bool cut = it.cut;
             if (it.slices.empty()) {
-                stack_.push_back(nodeItem(members_[it.lo + i]));
+                stack_.push_back(nodeItem(members_[it.lo + i], cut));
             } else {
                 Item g;
                 g.group = true;
+                g.cut = cut;
                 g.lo = it.slices[i].first;
                 g.hi = it.slices[i].second;
                 stack_.push_back(std::move(g));
@@ -644,6 +670,7 @@ class TreeWriter {
     std::vector<Box> boxes_;
     uint32_t maxChildren_;
     bool wrapped_;  // materials are POV-Ray `material`s (materialWrapped)
+    bool merges_;   // unions below an intersection or difference are merges (unionWord)
     std::vector<Item> stack_;
     std::vector<uint32_t> members_;
 };
@@ -665,7 +692,7 @@ PovWriteStats writePov(const Graph& g, const ExpandedTree& tree, std::ostream& o
     Out o(out);
     putHeader(o, g, tree, options);
     if (!tree.empty()) {
-        TreeWriter w(o, tree, options, stats, materialWrapped(g));
+        TreeWriter w(o, tree, options, stats, materialWrapped(g), anyLetsLightThrough(g));
         w.write(tree.root);
     } else {
         o.put("// the scene expands to nothing\n");

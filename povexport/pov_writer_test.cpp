@@ -110,8 +110,9 @@ TEST(PovWriter, EachMaterialIsDeclaredOnceAsATexture) {
 }
 
 // Section 10's finish items are written where they differ from POV-Ray's defaults; a
-// material with an interior makes every material a POV-Ray `material`, so that the
-// interior travels with its texture.
+// material with an interior makes every material a POV-Ray `material` with an interior
+// (ior 1 where the scene gives none), so that each use of one is an object with its own
+// interior, as the tracer's interiors are.
 TEST(PovWriter, FinishItemsAndInteriors) {
     Graph g;
     defaultScene(g);
@@ -133,9 +134,11 @@ TEST(PovWriter, FinishItemsAndInteriors) {
     g.axiom =
         g.addOperator(CsgOp::Union, {paint(g, 1, primitive(g, P::Sphere)), primitive(g, P::Cube)});
     const std::string s = exportText(g);
-    EXPECT_NE(s.find("#declare M0 = material { texture { pigment { color rgb <1,1,1> } finish { "
-                     "ambient 0.1 diffuse 0.6 phong 0 phong_size 40 reflection 0 } } }"),
-              std::string::npos)
+    EXPECT_NE(
+        s.find(
+            "#declare M0 = material { texture { pigment { color rgb <1,1,1> } finish { "
+            "ambient 0.1 diffuse 0.6 phong 0 phong_size 40 reflection 0 } } interior { ior 1 } }"),
+        std::string::npos)
         << s;
     EXPECT_NE(s.find("#declare M1 = material { texture { pigment { color rgb <1,1,1> } finish { "
                      "ambient 0.1 diffuse 0.6 brilliance 2 phong 0 phong_size 40 specular 0.5 "
@@ -176,6 +179,46 @@ TEST(PovWriter, FilterTransmitFadeAndTraceLevel) {
                      "<0.5,0,0> } }"),
               std::string::npos)
         << s;
+}
+
+// A material that lets light through, without an interior, makes every material a POV-Ray
+// `material` with an interior too: without, POV-Ray would give all objects the root's one
+// interior.
+TEST(PovWriter, TransparencyGivesEveryMaterialAnInterior) {
+    Graph g;
+    defaultScene(g);
+    Material veil;
+    veil.transmit = 0.5;
+    g.materials.push_back(veil);
+    g.axiom =
+        g.addOperator(CsgOp::Union, {paint(g, 1, primitive(g, P::Sphere)), primitive(g, P::Cube)});
+    const std::string s = exportText(g);
+    EXPECT_EQ(occurrences(s, "interior { ior 1 } }"), 2u) << s;
+    EXPECT_EQ(occurrences(s, "material{M1}"), 1u);
+    EXPECT_EQ(occurrences(s, "material{M0}"), 1u);
+    EXPECT_EQ(occurrences(s, "texture{M"), 0u);
+}
+
+// Below an intersection or difference, a union is written as POV-Ray's merge when some
+// material lets light through: the tracer's span lists have no surfaces inside the union
+// there, POV-Ray's union keeps them, and light passing through would show them. At the
+// top, the tracer's first hits see them too, and a union stays a union.
+TEST(PovWriter, AUnionInACutIsAMergeWhenLightPasses) {
+    for (const bool transparent : {false, true}) {
+        Graph g;
+        defaultScene(g);
+        Material glass;
+        glass.transmit = transparent ? 0.5 : 0;
+        g.materials.push_back(glass);
+        const NodeId u =
+            g.addOperator(CsgOp::Union, {primitive(g, P::Sphere), primitive(g, P::Cube)});
+        const NodeId cut =
+            g.addOperator(CsgOp::Difference, {paint(g, 1, u), primitive(g, P::Cylinder)});
+        g.axiom = g.addOperator(CsgOp::Union, {cut, primitive(g, P::Cone)});
+        const std::string s = exportText(g);
+        EXPECT_EQ(occurrences(s, "merge {"), transparent ? 1u : 0u) << s;
+        EXPECT_EQ(occurrences(s, "union {"), transparent ? 1u : 2u) << s;
+    }
 }
 
 // A paint node's material is one texture where the paint stands (docs/language.md

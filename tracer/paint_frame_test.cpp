@@ -147,5 +147,48 @@ TEST(PaintFrame, AnInnerPaintWithoutAPatternHasNone) {
     EXPECT_GT(plainHits, 10);
 }
 
+// Interiors (transparency.h): in a scene with transparency, a hit knows the paint node
+// instance that applied its material. Two instances of one paint node (a rule used
+// twice) are two interiors, the primitives under one paint node instance share one, and
+// a surface under no paint node has the default interior 0. Without transparency no
+// paint node records anything.
+TEST(PaintFrame, HitsKnowTheirPaintNodeInstance) {
+    const std::string scene = R"(
+material glass { pigment { color rgbf <1, 1, 1, 0.9> } interior { ior 1.5 } }
+move(-3, 0, 0) B ∪ B ∪ paint(glass) (move(3, 0, 0) sphere ∪ move(3, 0, 3) sphere) ∪
+  move(6, 0, 0) sphere
+B 1
+1: B -> paint(glass) sphere
+)";
+    const auto interiorAt = [](Tracer& t, double x, double z) {
+        SurfaceHit h;
+        EXPECT_TRUE(t.firstHit(Vec3{x, -10, z}, Vec3{0, 1, 0}, 1e-6, 1e9, h));
+        return h.interior;
+    };
+    for (const bool transparent : {true, false}) {
+        std::string text = scene;
+        if (!transparent) text.replace(text.find("rgbf <1, 1, 1, 0.9>"), 19, "rgb <1, 1, 1>");
+        auto c = compile(text);
+        ASSERT_TRUE(c->graph);
+        TraceScene ts(*c->graph, computeBounds(*c->graph));
+        Tracer t(ts);
+        const uint64_t left = interiorAt(t, -3, 0), middle = interiorAt(t, 0, 0);
+        const uint64_t low = interiorAt(t, 3, 0), high = interiorAt(t, 3, 3);
+        EXPECT_EQ(interiorAt(t, 6, 0), 0u);
+        if (!transparent) {
+            EXPECT_EQ(left | middle | low | high, 0u);
+            continue;
+        }
+        EXPECT_NE(left, 0u);
+        EXPECT_NE(middle, 0u);
+        EXPECT_NE(low, 0u);
+        EXPECT_NE(left, middle);
+        EXPECT_NE(left, low);
+        EXPECT_NE(middle, low);
+        EXPECT_EQ(low, high);
+        EXPECT_EQ(interiorAt(t, -3, 0.5), left);  // the same instance, another ray
+    }
+}
+
 }  // namespace
 }  // namespace pcsg::tracer

@@ -19,7 +19,8 @@ struct Shader::Surface {
     int level;  // the trace level of the ray that hit (the camera ray's hit: 1)
     double t;
     Vec3 p, n;
-    uint32_t material;
+    Vec3 raw;           // the surface's own normal facing the ray (n before a normal pattern)
+    Interior interior;  // its object's (transparency.h), whose material is m
     const Material& m;
     FilterColour pigment;
     Reflectivity reflection;
@@ -49,20 +50,24 @@ Vec3 Shader::shadeHit(const TreeRay& ray, const SurfaceHit& hit, double weight, 
     Vec3 n = normalize(hit.normal);
     if (!isFinite(n)) n = -ray.dir;  // degenerate normal (apex of a cone): face the viewer
     if (dot(n, ray.dir) > 0) n = -n;
+    const Vec3 raw = n;
     const uint32_t mi = hit.material < g_.materials.size() ? hit.material : 0;
     const Material& m = g_.materials[mi];
     if (m.normal.kind != NormalKind::None && hit.painted) n = perturbedNormal(m.normal, hit, n);
     const FilterColour pigment = pigmentColour(m, hit);
     const double cosIncidence = -dot(ray.dir, n);
-    const Surface s{ray,
-                    continued ? ray.level : ray.level + 1,
-                    hit.t,
-                    ray.origin + ray.dir * hit.t,
-                    n,
-                    mi,
-                    m,
-                    pigment,
-                    reflectivity(m, cosIncidence, pigment.rgb, relativeIor(ray.inside, mi, g_))};
+    const Interior interior{hit.interior, mi};
+    const Surface s{
+        ray,
+        continued ? ray.level : ray.level + 1,
+        hit.t,
+        ray.origin + ray.dir * hit.t,
+        n,
+        raw,
+        interior,
+        m,
+        pigment,
+        reflectivity(m, cosIncidence, pigment.rgb, relativeIor(ray.inside, interior, g_))};
     return shadeSurface(s, weight);
 }
 
@@ -79,6 +84,14 @@ Vec3 Shader::shadeSurface(const Surface& s, double weight) {
     return colour;
 }
 
+namespace {
+// The normal n turned to face a ray in direction d: a normal pattern may have tilted the
+// normal away from the ray, and POV-Ray's ComputeRefraction refracts at it turned back.
+Vec3 facingRay(const Vec3& n, const Vec3& d) {
+    return dot(d, n) > 0 ? -n : n;
+}
+}  // namespace
+
 // The light through the surface (ComputeRefraction, TraceRefractionRay): a straight ray
 // between equal iors, a refracted one, or on total internal reflection the reflected ray.
 Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection) {
@@ -89,12 +102,12 @@ Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection)
     if (!(trans > bailout)) return Vec3{0, 0, 0};
     const double w = weight * maxAbs(passes);
     TreeRay next{s.p, s.ray.dir, s.level, s.ray.inside, s.ray.straight};
-    const double ior = crossSurface(next.inside, s.material, g_);
+    const double ior = crossSurface(next.inside, s.interior, g_);
     Vec3 light;
     if (std::fabs(ior - 1.0) < C::kEpsilon) {
         next.straight = s.ray.straight + 1;
         light = trace(next, w, true);
-    } else if (const auto d = refractDirection(s.ray.dir, s.n, ior)) {
+    } else if (const auto d = refractDirection(s.ray.dir, facingRay(s.n, s.ray.dir), ior)) {
         next.dir = normalize(*d);
         light = trace(next, w, false);
     } else {
@@ -102,13 +115,25 @@ Vec3 Shader::transmitted(const Surface& s, double weight, bool& totalReflection)
         light = reflected(s, w);
     }
     // Light that travelled inside this interior fades on the way.
-    if (s.ray.inside.contains(s.material)) light = mul(light, fade(s.m, s.t));
+    if (s.ray.inside.contains(s.interior.id)) light = mul(light, fade(s.m, s.t));
     return totalReflection ? light : mul(light, passes);
 }
 
 // The ray mirrored at the surface (ComputeReflection), in the incoming ray's interiors.
+// A normal pattern may tilt the normal so far that the mirrored ray goes into the surface
+// (below its own normal); POV-Ray then mirrors it at the surface's own normal instead
+// when it also goes against the tilted one, else mirrors it once more at the own normal
+// (its "reflection bugfix" of 1998).
 Vec3 Shader::reflected(const Surface& s, double weight) {
-    const Vec3 d = normalize(s.ray.dir - s.n * (2 * dot(s.ray.dir, s.n)));
+    Vec3 d = s.ray.dir - s.n * (2 * dot(s.ray.dir, s.n));
+    const double below = dot(d, s.raw);
+    if (below < 0) {
+        if (dot(d, s.n) < 0)
+            d = s.ray.dir - s.raw * (2 * dot(s.ray.dir, s.raw));
+        else
+            d = d + s.raw * (-2 * below);
+    }
+    d = normalize(d);
     return trace(TreeRay{s.p, d, s.level, s.ray.inside, s.ray.straight}, weight, false);
 }
 
@@ -134,8 +159,8 @@ Vec3 Shader::shadowFilter(const Vec3& p, const Vec3& l, double dist, const Inter
         const FilterColour pigment = pigmentColour(m, hit);
         if (!isTransparent(pigment)) return Vec3{0, 0, 0};
         Vec3 through = transmittedColour(pigment);
-        if (inside.contains(mi)) through = mul(through, fade(m, hit.t, true));
-        if (!inside.remove(mi)) inside.push(mi);
+        if (inside.contains(hit.interior)) through = mul(through, fade(m, hit.t, true));
+        if (!inside.remove(hit.interior)) inside.push(Interior{hit.interior, mi});
         if ((std::fabs(through.x) + std::fabs(through.y) + std::fabs(through.z)) / 3 < bailout)
             return Vec3{0, 0, 0};
         filter = mul(filter, through);
@@ -159,20 +184,21 @@ const Interiors& Shader::startInteriors(const Vec3& at) {
     startInside_ = Interiors{};
     if (!anyTransparent_) return startInside_;
     const Vec3 d = normalize(Vec3{0.5773, 0.5774, 0.5775});  // away from the axes
-    std::vector<uint32_t> entered, left;
+    std::vector<Interior> entered, left;
     Vec3 origin = at;
     SurfaceHit hit;
     for (int k = 0; k < 100000; ++k) {
         if (!tracer_.firstHit(origin, d, C::kMinIsectDepth, C::kMaxDistance, hit)) break;
-        const uint32_t mi = hit.material < g_.materials.size() ? hit.material : 0;
+        const Interior here{hit.interior, hit.material < g_.materials.size() ? hit.material : 0};
         if (dot(hit.normal, d) > 0) {
-            const auto it = std::find(entered.rbegin(), entered.rend(), mi);
+            const auto it = std::find_if(entered.rbegin(), entered.rend(),
+                                         [&](const Interior& i) { return i.id == here.id; });
             if (it != entered.rend())
                 entered.erase(std::next(it).base());
             else
-                left.push_back(mi);
+                left.push_back(here);
         } else {
-            entered.push_back(mi);
+            entered.push_back(here);
         }
         origin = origin + d * hit.t;
     }

@@ -43,7 +43,12 @@
 //      * `reflection { ... metallic k }` tints the amount by 1 + k (1 - F) (pigment - 1),
 //        F as above of acos(cos);
 //      * the colour gets + amount * colour(reflected ray), the reflected ray starting at P
-//        in direction D - 2 (D . N) N, inside the same interiors as the incoming ray.
+//        in direction D - 2 (D . N) N, inside the same interiors as the incoming ray;
+//        where a normal pattern tilted N so far that this direction goes below the
+//        surface's own normal R (facing the ray), POV-Ray's correction: mirrored at R
+//        instead when it also goes against N, else mirrored once more at R. A transmitted
+//        ray is refracted at N turned towards the ray, should the pattern have tilted it
+//        away (ComputeRefraction).
 //  - The ray tree (ray_tree.cpp, POV-Ray's TraceRay): every surface may spawn a reflected
 //    and a transmitted ray (transparency.h has filter, transmit, refraction, fade and
 //    filtered shadows). A ray whose weight is below adc_bailout (settings, default 1/255)

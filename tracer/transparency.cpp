@@ -10,15 +10,15 @@ constexpr double kEpsilon = 1e-10;
 constexpr double kAtmosphereIor = 1.0;
 }  // namespace
 
-bool Interiors::contains(uint32_t interior) const {
+bool Interiors::contains(uint64_t id) const {
     for (int i = 0; i < size_; ++i)
-        if (items_[i] == interior) return true;
+        if (items_[i].id == id) return true;
     return false;
 }
 
-bool Interiors::remove(uint32_t interior) {
+bool Interiors::remove(uint64_t id) {
     for (int i = size_ - 1; i >= 0; --i) {
-        if (items_[i] != interior) continue;
+        if (items_[i].id != id) continue;
         for (int j = i + 1; j < size_; ++j) items_[j - 1] = items_[j];
         --size_;
         return true;
@@ -26,7 +26,7 @@ bool Interiors::remove(uint32_t interior) {
     return false;
 }
 
-void Interiors::push(uint32_t interior) {
+void Interiors::push(const Interior& interior) {
     if (size_ < kCapacity) items_[size_++] = interior;
 }
 
@@ -34,28 +34,28 @@ double iorOf(const Graph& g, uint32_t material) {
     return material < g.materials.size() ? g.materials[material].ior : 1.0;
 }
 
-double crossSurface(Interiors& in, uint32_t material, const Graph& g) {
-    const double ior = iorOf(g, material);
+double crossSurface(Interiors& in, const Interior& s, const Graph& g) {
+    const double ior = iorOf(g, s.material);
     if (in.empty()) {  // entering from the atmosphere
-        in.push(material);
+        in.push(s);
         return kAtmosphereIor / ior;
     }
-    if (in.innermost() == material) {  // leaving the innermost object
-        in.remove(material);
-        return ior / (in.empty() ? kAtmosphereIor : iorOf(g, in.innermost()));
+    if (in.innermost().id == s.id) {  // leaving the innermost object
+        in.remove(s.id);
+        return ior / (in.empty() ? kAtmosphereIor : iorOf(g, in.innermost().material));
     }
-    if (in.remove(material)) return 1.0;  // leaving an overlap: no change
-    const double outside = iorOf(g, in.innermost());
-    in.push(material);  // entering a new object from inside another
+    if (in.remove(s.id)) return 1.0;  // leaving an overlap: no change
+    const double outside = iorOf(g, in.innermost().material);
+    in.push(s);  // entering a new object from inside another
     return outside / ior;
 }
 
-double relativeIor(const Interiors& in, uint32_t material, const Graph& g) {
-    const double ior = iorOf(g, material);
+double relativeIor(const Interiors& in, const Interior& s, const Graph& g) {
+    const double ior = iorOf(g, s.material);
     if (in.empty()) return ior / kAtmosphereIor;
-    if (in.contains(material))
-        return (in.size() == 1 ? kAtmosphereIor : iorOf(g, in.innermost())) / ior;
-    return ior / iorOf(g, in.innermost());
+    if (in.contains(s.id))
+        return (in.size() == 1 ? kAtmosphereIor : iorOf(g, in.innermost().material)) / ior;
+    return ior / iorOf(g, in.innermost().material);
 }
 
 std::optional<Vec3> refractDirection(const Vec3& d, const Vec3& n, double ior) {
@@ -86,13 +86,8 @@ Vec3 fade(const Material& m, double depth, bool shadow) {
 }
 
 bool anyTransparent(const Graph& g) {
-    for (const Material& m : g.materials) {
-        if (m.filter != 0 || m.transmit != 0) return true;
-        for (const FilterColour& c : m.pigment.listColours)
-            if (isTransparent(c)) return true;
-        for (const ColourMapEntry& e : m.pigment.colourMap)
-            if (isTransparent(e.colour)) return true;
-    }
+    for (const Material& m : g.materials)
+        if (m.mayLetLightThrough()) return true;
     return false;
 }
 

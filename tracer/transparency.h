@@ -12,10 +12,15 @@
 //    0.297 r + 0.589 g + 0.114 b), with weight times the largest channel of what is let through.
 //  - The interior stack (Interiors): the interiors a ray is inside, innermost last; camera
 //    rays start with those of the solids containing the camera (POV-Ray's
-//    InitRayContainerState; Shader::startInteriors finds them with a probe ray). A
-//    surface's interior is its material (so two overlapping objects of one material count as
-//    one; POV-Ray tells them apart, see docs/language.md section 10). Crossing a surface of
-//    interior I (POV-Ray's rules, nested objects count as outside their container):
+//    InitRayContainerState; Shader::startInteriors finds them with a probe ray). An
+//    interior is an object's, as POV-Ray's: that of the paint node instance that applied
+//    the surface's material (the paint node with the instance path that reached it in the
+//    unrolled tree, SurfaceHit::interior), which is one `material { }` of the export and
+//    so one POV-Ray interior shared by the primitives below it; surfaces under no paint
+//    node share the scene's default interior (the root's). Two objects of one material
+//    that overlap or nest are two interiors; its ior and fade are the material's.
+//    Crossing a surface of interior I (POV-Ray's rules, nested objects count as outside
+//    their container):
 //      * stack empty: enter I, ior ratio 1 / ior(I);
 //      * I innermost: leave it, ratio ior(I) / ior(next innermost, or 1 outside);
 //      * I deeper in the stack: leave it, ratio 1;
@@ -43,31 +48,40 @@
 
 namespace pcsg::tracer {
 
-// The interiors a ray is inside (material indices), innermost last.
+// One object's interior: which object (the paint node instance, SurfaceHit::interior; 0:
+// the default interior of surfaces under no paint node) and the material whose ior and
+// fade it has.
+struct Interior {
+    uint64_t id = 0;
+    uint32_t material = 0;
+};
+
+// The interiors a ray is inside, innermost last.
 class Interiors {
   public:
     static constexpr int kCapacity = 32;
     bool empty() const { return size_ == 0; }
     int size() const { return size_; }
-    uint32_t innermost() const { return items_[size_ - 1]; }
-    bool contains(uint32_t interior) const;
-    bool remove(uint32_t interior);
-    void push(uint32_t interior);  // beyond kCapacity nesting levels, ignored
+    const Interior& innermost() const { return items_[size_ - 1]; }
+    bool contains(uint64_t id) const;
+    bool remove(uint64_t id);
+    void push(const Interior& interior);  // beyond kCapacity nesting levels, ignored
 
   private:
-    std::array<uint32_t, kCapacity> items_{};
+    std::array<Interior, kCapacity> items_{};
     int size_ = 0;
 };
 
 // The index of refraction of material `i` (1 past the end: the atmosphere's).
 double iorOf(const Graph& g, uint32_t material);
 
-// A ray crossing a surface of `material` updates `in` and returns n1 / n2 (ComputeRefraction).
-double crossSurface(Interiors& in, uint32_t material, const Graph& g);
+// A ray crossing a surface of interior `s` updates `in` and returns n1 / n2
+// (ComputeRefraction).
+double crossSurface(Interiors& in, const Interior& s, const Graph& g);
 
-// n2 / n1 seen by a ray with stack `in` at a surface of `material` (ComputeRelativeIOR),
+// n2 / n1 seen by a ray with stack `in` at a surface of interior `s` (ComputeRelativeIOR),
 // which fresnel reflection reads.
-double relativeIor(const Interiors& in, uint32_t material, const Graph& g);
+double relativeIor(const Interiors& in, const Interior& s, const Graph& g);
 
 // The refracted direction of unit `d` at a surface with unit normal `n` facing the ray, ratio
 // n1 / n2 `ior`; nothing on total internal reflection.

@@ -53,21 +53,41 @@ Graph threeInteriors() {
 
 TEST(Transparency, InteriorStackFollowsPovRaysRules) {
     const Graph g = threeInteriors();
+    const Interior glass{11, 1}, other{12, 2};  // two objects, of materials 1 and 2
     Interiors in;
-    EXPECT_DOUBLE_EQ(crossSurface(in, 1, g), 1 / 1.5);  // air into glass
-    EXPECT_DOUBLE_EQ(relativeIor(in, 2, g), 1.2 / 1.5);
-    EXPECT_DOUBLE_EQ(crossSurface(in, 2, g), 1.5 / 1.2);  // nested: glass into the other
+    EXPECT_DOUBLE_EQ(crossSurface(in, glass, g), 1 / 1.5);  // air into glass
+    EXPECT_DOUBLE_EQ(relativeIor(in, other, g), 1.2 / 1.5);
+    EXPECT_DOUBLE_EQ(crossSurface(in, other, g), 1.5 / 1.2);  // nested: glass into the other
     EXPECT_EQ(in.size(), 2);
-    EXPECT_DOUBLE_EQ(relativeIor(in, 2, g), 1.2 / 1.2);
-    EXPECT_DOUBLE_EQ(crossSurface(in, 2, g), 1.2 / 1.5);  // back out into the glass
-    EXPECT_DOUBLE_EQ(relativeIor(in, 1, g), 1 / 1.5);
-    EXPECT_DOUBLE_EQ(crossSurface(in, 1, g), 1.5);  // glass into air
+    EXPECT_DOUBLE_EQ(relativeIor(in, other, g), 1.2 / 1.2);
+    EXPECT_DOUBLE_EQ(crossSurface(in, other, g), 1.2 / 1.5);  // back out into the glass
+    EXPECT_DOUBLE_EQ(relativeIor(in, glass, g), 1 / 1.5);
+    EXPECT_DOUBLE_EQ(crossSurface(in, glass, g), 1.5);  // glass into air
     EXPECT_TRUE(in.empty());
     // Overlap (A (B A) B): leaving A while in B changes nothing, leaving B goes to air.
-    crossSurface(in, 1, g);
-    crossSurface(in, 2, g);
-    EXPECT_DOUBLE_EQ(crossSurface(in, 1, g), 1.0);
-    EXPECT_DOUBLE_EQ(crossSurface(in, 2, g), 1.2);
+    crossSurface(in, glass, g);
+    crossSurface(in, other, g);
+    EXPECT_DOUBLE_EQ(crossSurface(in, glass, g), 1.0);
+    EXPECT_DOUBLE_EQ(crossSurface(in, other, g), 1.2);
+    EXPECT_TRUE(in.empty());
+}
+
+// Interiors are objects, not materials: a second object of the same glass met from inside
+// the first is entered (ior 1.5 to 1.5: straight on), not taken for the way out of it.
+TEST(Transparency, TwoObjectsOfOneMaterialAreTwoInteriors) {
+    const Graph g = threeInteriors();
+    const Interior a{21, 1}, b{22, 1};
+    Interiors in;
+    EXPECT_DOUBLE_EQ(crossSurface(in, a, g), 1 / 1.5);
+    EXPECT_DOUBLE_EQ(relativeIor(in, b, g), 1.0);
+    EXPECT_DOUBLE_EQ(crossSurface(in, b, g), 1.0);  // into b, still in glass
+    EXPECT_EQ(in.size(), 2);
+    EXPECT_DOUBLE_EQ(crossSurface(in, a, g), 1.0);  // out of a, still in b
+    EXPECT_DOUBLE_EQ(crossSurface(in, b, g), 1.5);  // out of b into air
+    EXPECT_TRUE(in.empty());
+    // The same object twice is one interior: its far wall leads out.
+    crossSurface(in, a, g);
+    EXPECT_DOUBLE_EQ(crossSurface(in, a, g), 1.5);
     EXPECT_TRUE(in.empty());
 }
 

@@ -12,6 +12,7 @@
 
 #include "operators.h"
 #include "sanitizer.h"
+#include "transparency.h"
 
 namespace pcsg::tracer {
 
@@ -44,12 +45,16 @@ uintptr_t threadStackLimit() {
 // TraceScene
 
 // Materials whose pigment has a pattern need the hit point in their paint node's frame;
-// those with a normal pattern also the map into it. Scenes without either record nothing.
+// those with a normal pattern also the map into it. In scenes with transparency every
+// paint node records its instance (the interiors of transparency.h). Other scenes
+// record nothing.
 void TraceScene::markPaintFrames() {
     std::vector<uint8_t> marks(g_.materials.size(), 0);
     bool any = false;
+    interiors = anyTransparent(g_);
     for (size_t i = 0; i < marks.size(); ++i) {
         const Material& m = g_.materials[i];
+        if (interiors) marks[i] |= kPaintInterior;
         if (m.pigment.pattern.kind != PatternKind::Plain) marks[i] |= kPaintPoint;
         if (m.normal.kind != NormalKind::None) marks[i] |= kPaintPoint | kPaintMap;
         any = any || marks[i] != 0;
@@ -170,6 +175,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     spans_.clear();
     order_.clear();
     paintRays_.clear();
+    paintInteriors_.clear();
     paintMaps_.clear();
     inverses_.clear();
     if (g_.axiom == kNone) return false;
@@ -187,6 +193,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     out.material = hit.material;
     out.painted = hit.paint != 0;
     if (out.painted) {
+        out.interior = paintInteriors_[hit.paint - 1];
         const LocalRay& p = paintRays_[hit.paint - 1];
         out.paintPoint = p.o + p.d * hit.t;
         if (scene_.paintMaps) out.paintMap = &paintMaps_[hit.paint - 1];
@@ -238,6 +245,8 @@ template <class Below, class Unrolled, class TransformBack>
     Step st = sem.enter(n, c, scratch);
     if (kind == NodeKind::Paint && !anyHit_ && scene_.paintFrameOf(st.state.material)) {
         paintRays_.push_back(r);  // a paint node keeps the frame: r is the ray in its frame
+        // and its instance: the node and its instance path (never 0, the default interior)
+        paintInteriors_.push_back(pathChild(c.path, 0x80000000u | n) | 1);
         st.state.paint = static_cast<uint32_t>(paintRays_.size());
         if (scene_.paintMaps) paintMaps_.push_back(paintMapHere(st.state.material));
     }

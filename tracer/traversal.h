@@ -70,6 +70,10 @@ struct SurfaceHit {
     // world into the paint node's frame, owned by the tracer and valid until its next
     // walk (a pointer, so that rays of scenes without patterns carry no matrix).
     const Affine* paintMap = nullptr;
+    // Scenes with transparency (TraceScene::interiors): the object whose interior the
+    // surface is in (transparency.h), the paint node instance that applied its material (a
+    // hash of the node and its instance path; 0: under no paint node).
+    uint64_t interior = 0;
 };
 
 // The graph with everything the walk precomputes once: its semantics (with the fused
@@ -108,8 +112,11 @@ class TraceScene {
     // has a pattern: kPaintPoint), and the map into that frame too (its normal has a
     // pattern: kPaintMap). Empty: none does, and the walk records no frames.
     std::vector<uint8_t> paintFrames;
-    static constexpr uint8_t kPaintPoint = 1, kPaintMap = 2;
+    // kPaintInterior: every material, in scenes with transparency (`interiors`), so that a
+    // hit knows its paint node instance (SurfaceHit::interior).
+    static constexpr uint8_t kPaintPoint = 1, kPaintMap = 2, kPaintInterior = 4;
     bool paintMaps = false;  // some material needs kPaintMap
+    bool interiors = false;  // some material may let light through
     bool paintMapOf(uint32_t material) const {
         return material < paintFrames.size() && (paintFrames[material] & kPaintMap);
     }
@@ -205,6 +212,7 @@ class Tracer {
     std::vector<std::pair<double, uint32_t>> order_;
     std::vector<LocalRay>
         paintRays_;  // the ray in the frame of each paint node (PathState::paint - 1)
+    std::vector<uint64_t> paintInteriors_;  // and that paint node instance's interior
     // With TraceScene::paintMaps: the inverse matrices of the T-nodes above the node being
     // visited, outermost first, and the map from the world into each paint node's frame
     // (beside paintRays_; identity where the material has no normal pattern).

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "appearance.h"
 #include "bounds.h"
 #include "compiler.h"
 
@@ -312,14 +313,8 @@ std::string Generator::materialsText() {
     if (rng_.percent(20))
         s += fmt::format("material default {{ color {}  diffuse {}  phong {} }}\n", vec(300, 1000),
                          n(300, 900), n(0, 600));
-    for (int k = 0; k < materials_; ++k) {
-        s += fmt::format("material m{} {{ color {}  ambient {}  diffuse {}", k, vec(150, 1000),
-                         n(0, 300), n(300, 900));
-        if (rng_.percent(50))
-            s += fmt::format("  phong {}  phong_size {}", n(0, 900), n(5000, 80000));
-        if (rng_.percent(25)) s += fmt::format("  reflection {}", n(50, 400));
-        s += " }\n";
-    }
+    for (int k = 0; k < materials_; ++k)
+        s += fmt::format("material m{} {{ {} }}\n", k, materialBody(rng_));
     return s;
 }
 
@@ -372,10 +367,14 @@ std::string Generator::frame(const std::string& body, bool ground, double& groun
     std::string s = fmt::format("camera {{ location {}  look_at {}  sky <0, 0, 1>  angle 45 }}\n",
                                 fixedVec(eye), fixedVec(centre));
     const int lights = int(rng_.range(1, 2));
-    for (int k = 0; k < lights; ++k)
-        s += fmt::format("light {{ position {}  color {} }}\n",
-                         fixedVec(centre + direction(200, 1000) * (radius * 8)), vec(400, 1000));
-    return s + fmt::format("background {}\n", vec(0, 500));
+    for (int k = 0; k < lights; ++k) {
+        const std::string at = fixedVec(centre + direction(200, 1000) * (radius * 8));
+        const std::string colour = vec(400, 1000);
+        s += fmt::format("light {{ position {}  color {}{} }}\n", at, colour,
+                         lightExtras(rng_, radius, fixedVec(centre)));
+    }
+    s += fmt::format("background {}\n", vec(0, 500));
+    return s + sceneExtras(rng_, radius, groundZ);
 }
 
 std::string Generator::run() {

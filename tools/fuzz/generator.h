@@ -15,7 +15,9 @@
 //  - rule bodies nesting ∪ ∩ \ with every transformation and every primitive, C-nodes,
 //    paint, rand() and rand(x); triangles only in modules that no ∩ or \ can reach;
 //  - materials, one or two lights, a background, and sometimes a ground plane below the
-//    object.
+//    object; sometimes section 10's appearance items (appearance.h): patterns, normals,
+//    finish items, transparency and interiors in materials, area lights and spotlights,
+//    fog and a sky_sphere.
 // Surfaces are never exactly coincident: every primitive gets its own random offset and
 // size (in thousandths), and every recursive call its own random transformation.
 #pragma once

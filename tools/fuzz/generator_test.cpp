@@ -2,7 +2,7 @@
 // same text every time and different seeds different texts; every system of a range of
 // seeds compiles, expands without a run-time error into a small tree, and survives the
 // formatter (fmt(fmt(x)) == fmt(x), fmt(x) compiles to x's graph); a campaign of them
-// covers every feature.
+// covers every feature, section 10's appearance items included.
 #include "generator.h"
 
 #include <gtest/gtest.h>
@@ -56,7 +56,7 @@ TEST(FuzzGenerator, SameSeedSameTextOtherSeedOtherText) {
 
 TEST(FuzzGenerator, EverySystemCompilesExpandsAndFormats) {
     std::map<std::string, int> coverage;
-    for (uint64_t i = 0; i < 60; ++i) {
+    for (uint64_t i = 0; i < 120; ++i) {
         const std::string text = generateSystem(systemSeed(7, i));
         SCOPED_TRACE(text);
         Diagnostics diags;
@@ -92,6 +92,23 @@ TEST(FuzzFeatures, ReadTheSyntaxTree) {
                                         "cube",       "intersection", "calc",     "paint", "torus"};
     EXPECT_EQ(some, want);
     EXPECT_TRUE(featuresOf("sphere ∪").empty());  // does not parse
+}
+
+// Section 10's items are read from the tokens, by the block they stand in: `dents` in a
+// pigment is a pigment pattern, in a normal a normal pattern; rgbft is filter and transmit.
+TEST(FuzzFeatures, ReadTheAppearanceItems) {
+    const std::set<std::string> found = featuresOf(
+        "light { position <1, 2, 3>  color <1, 1, 1>  spotlight point_at <0, 0, 0> }\n"
+        "fog { distance 3  color <1, 1, 1> }\n"
+        "material m { pigment { spotted color_map { [0 color rgbft <1, 1, 1, 0.2, 0.3>] "
+        "[1 color rgb <0, 0, 0>] } turbulence 0.2 scale 0.5 } normal { dents 0.4 } "
+        "finish { specular 0.5 reflection { 0, 0.5 fresnel on } } interior { ior 1.5 } }\n"
+        "paint(m) sphere");
+    const std::set<std::string> want = {
+        "paint",        "sphere",   "spotlight", "fog",        "pigment_bozo",
+        "color_map",    "filter",   "transmit",  "turbulence", "pattern_transform",
+        "normal_dents", "specular", "fresnel",   "ior"};
+    EXPECT_EQ(found, want);
 }
 
 }  // namespace
