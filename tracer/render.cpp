@@ -72,9 +72,10 @@ double aaEncode(double c) {
     return c > 0 ? std::pow(c, 1.0 / 2.5) : 0.0;
 }
 
-double colourDistance(const float* a, const float* b) {
+// The distance of two pixels' colours already encoded by aaEncode.
+double colourDistance(const double* a, const double* b) {
     double d = 0;
-    for (int k = 0; k < 3; ++k) d += std::fabs(aaEncode(a[k]) - aaEncode(b[k]));
+    for (int k = 0; k < 3; ++k) d += std::fabs(a[k] - b[k]);
     return d;
 }
 
@@ -120,8 +121,10 @@ class TileRender {
         forTiles(1, halo_, [&](Worker& wk, int x, int y) { samplePixel(wk, x, y); });
         if (opt_.adaptive > 0 && !stop_) {
             const std::vector<float> centres = rgb_;
-            forTiles(2, region_,
-                     [&](Worker& wk, int x, int y) { supersamplePixel(wk, centres, x, y); });
+            const std::vector<double> encoded = encodeCentres(centres);
+            forTiles(2, region_, [&](Worker& wk, int x, int y) {
+                supersamplePixel(wk, centres, encoded, x, y);
+            });
         }
         if (firstError_) std::rethrow_exception(firstError_);
         if (stop_) throw RenderCancelled();
@@ -195,7 +198,8 @@ class TileRender {
         return rgb.data() +
                (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
     }
-    const float* pixelAt(const std::vector<float>& rgb, int x, int y) const {
+    template <class T>
+    const T* pixelAt(const std::vector<T>& rgb, int x, int y) const {
         return rgb.data() +
                (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
     }
@@ -216,15 +220,28 @@ class TileRender {
         store(x, y, sum / static_cast<double>(aa * aa));
     }
 
+    // The pass-1 colours encoded by aaEncode, once per pixel (each pixel is compared with
+    // up to four neighbours), in parallel by rows.
+    std::vector<double> encodeCentres(const std::vector<float>& centres) const {
+        std::vector<double> encoded(centres.size());
+        const size_t row = static_cast<size_t>(halo_.width()) * 3;
+        tbb::parallel_for(0, halo_.height(), [&](int y) {
+            for (size_t k = y * row; k < (y + 1) * row; ++k) encoded[k] = aaEncode(centres[k]);
+        });
+        return encoded;
+    }
+
     // Pass 2 of adaptive sampling (POV-Ray's +A, method 1): a pixel whose centre differs
     // from a 4-neighbour's by the threshold or more gets depth x depth more samples.
-    void supersamplePixel(Worker& wk, const std::vector<float>& centres, int x, int y) {
+    void supersamplePixel(Worker& wk, const std::vector<float>& centres,
+                          const std::vector<double>& encoded, int x, int y) {
         const float* c = pixelAt(centres, x, y);
+        const double* e = pixelAt(encoded, x, y);
         bool differs = false;
         const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
         for (int k = 0; k < 4 && !differs; ++k) {
             if (nx[k] < 0 || nx[k] >= w_ || ny[k] < 0 || ny[k] >= h_) continue;
-            differs = colourDistance(c, pixelAt(centres, nx[k], ny[k])) >= opt_.adaptive;
+            differs = colourDistance(e, pixelAt(encoded, nx[k], ny[k])) >= opt_.adaptive;
         }
         if (!differs) return;
         const int depth = std::max(1, opt_.adaptiveDepth);

@@ -148,11 +148,11 @@ bool Tracer::selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t de
                           double tmax) {
     if (!scene_.useBounds) return false;
     double t0 = tmin, t1 = tmax;
-    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r.o, r.d, t0, t1)) return true;
+    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r, t0, t1)) return true;
     const InstanceBoxes* boxes = scene_.instanceBoxes_.get();
     if (!boxes || !boxes->useAt(n, depth)) return false;
     const Box exact = boxes->box(*boxWorker_, n, depth, c.frame, c.path);
-    return !clipToBox(exact, r.o, r.d, t0, t1);
+    return !clipToBox(exact, r, t0, t1);
 }
 
 void Tracer::checkStack() {
@@ -302,7 +302,7 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 [&](uint32_t i, double& t0) {
                     double t1 = tmax;
                     return !scene_.useBounds ||
-                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, t0, t1);
+                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r, t0, t1);
                 },
                 [&](uint32_t i, double& best, Hit& h) {
                     return first(g_.child(n, i), r, Semantics::operand(c, i), tmin, best, h);
@@ -375,7 +375,7 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
                 node.op(), node.childCount, spans_, tmin, tmax,
                 [&](uint32_t i, double lo, double hi) {
                     return !scene_.useBounds ||
-                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, lo, hi);
+                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r, lo, hi);
                 },
                 [&](uint32_t i, double lo, double hi) {
                     return spans(g_.child(n, i), r, Semantics::operand(c, i), lo, hi);
