@@ -109,14 +109,21 @@ size_t TraceScene::stackBytesNeeded() const {
 
 Tracer::FrameStack::FrameStack(size_t frameSize)
     : frameSize_(std::max<size_t>(frameSize, 1)),
-      perBlock_(std::max<size_t>(4096 / frameSize_, 16)) {}
+      perBlock_(std::max<size_t>(4096 / frameSize_, 16)),
+      slot_(perBlock_) {}
 
-double* Tracer::FrameStack::push() {
+// The top block is full (or there is none): the next one, made the first time.
+void Tracer::FrameStack::nextBlock() {
     const size_t b = used_ / perBlock_;
     if (b == blocks_.size()) blocks_.push_back(std::make_unique<double[]>(perBlock_ * frameSize_));
-    double* f = blocks_[b].get() + (used_ % perBlock_) * frameSize_;
-    ++used_;
-    return f;
+    block_ = blocks_[b].get();
+    slot_ = 0;
+}
+
+// The top block became empty: the one below it, full.
+void Tracer::FrameStack::previousBlock() {
+    slot_ = perBlock_;
+    block_ = used_ == 0 ? nullptr : blocks_[used_ / perBlock_ - 1].get();
 }
 
 Tracer::Tracer(const TraceScene& scene)
@@ -155,14 +162,15 @@ bool Tracer::selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t de
     return !clipToBox(exact, r, t0, t1);
 }
 
-void Tracer::checkStack() {
-    const auto here = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));
-    if (here < lowWater_) lowWater_ = here;
-    if (stackLimit_ == 0) stackLimit_ = threadStackLimit();
-    if (here < stackLimit_)
-        throw StackExhausted(fmt::format(
-            "the ray tracer's stack is too small for this scene's recursion depth (max_depth {})",
-            g_.scene.settings.maxDepth));
+// The walk is below stackLimit_: learns the limit the first time, else throws.
+void Tracer::checkStackLimit(uintptr_t here) {
+    if (stackLimit_ == UINTPTR_MAX) {
+        stackLimit_ = threadStackLimit();
+        if (here >= stackLimit_) return;
+    }
+    throw StackExhausted(fmt::format(
+        "the ray tracer's stack is too small for this scene's recursion depth (max_depth {})",
+        g_.scene.settings.maxDepth));
 }
 
 bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
