@@ -27,7 +27,7 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
+#include <new>
 #include <vector>
 
 #include "eval.h"
@@ -62,8 +62,22 @@ struct StepScratch {
     struct Matrices {
         Affine forward, inverse;
     };
+    // Room for a T-node's matrices, made by emplace() only when the step needs them (not a
+    // std::optional: GCC 12 zero-fills an optional's 192 bytes on construction, and every
+    // node visit of every ray makes a StepScratch).
+    class MatrixRoom {
+      public:
+        MatrixRoom() {}
+        Matrices& emplace() { return *new (&room_.m) Matrices(); }
+
+      private:
+        union Room {
+            Room() {}
+            Matrices m;
+        } room_;
+    };
     double* frame = nullptr;
-    std::optional<Matrices> matrices;
+    MatrixRoom matrices;
     StepMemo* memo = nullptr;
 };
 

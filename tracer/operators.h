@@ -17,6 +17,10 @@
 #include <utility>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "geometry.h"
 #include "graph.h"
 #include "primitives.h"
@@ -25,9 +29,31 @@
 namespace pcsg::tracer {
 
 // A ray in some node's frame: the direction is never normalised, so t is the same number
-// in every frame.
+// in every frame. The reciprocals of the direction's components are computed at the ray's
+// first box test in this frame (clipToBox below) and kept for the others: a node's boxes
+// are tested with one set of divisions, and rays that meet no box (into a primitive) pay
+// none.
 struct LocalRay {
     Vec3 o, d;
+
+    LocalRay(const Vec3& origin, const Vec3& dir) : o(origin), d(dir) {}
+
+    // 1 / d per axis; hasZeroAxis(): some component of d is zero (its reciprocal is
+    // infinite, and the box test takes the careful path).
+    const Vec3& inverse() const {
+        if (inverseState_ == kUnknown) computeInverse();
+        return inverse_;
+    }
+    bool hasZeroAxis() const { return inverseState_ == kZeroAxis; }
+
+  private:
+    static constexpr uint8_t kUnknown = 0, kFinite = 1, kZeroAxis = 2;
+    void computeInverse() const {
+        inverse_ = Vec3{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
+        inverseState_ = (d.x == 0 || d.y == 0 || d.z == 0) ? kZeroAxis : kFinite;
+    }
+    mutable Vec3 inverse_;
+    mutable uint8_t inverseState_ = kUnknown;
 };
 
 // The nearest surface found so far.
@@ -63,6 +89,49 @@ inline bool clipToBox(const Box& b, const Vec3& o, const Vec3& d, double& t0, do
     return true;
 }
 
+// The same for a LocalRay, with the reciprocals of its direction computed once per frame,
+// and the same arithmetic: every bound is (lo - o) * (1 / d) as above, and the result is
+// the same (where the loop above stops at the first axis that empties [t0, t1], this takes
+// all three, which only shrinks [t0, t1] further; nothing reads t0 and t1 after false).
+inline bool clipToBox(const Box& b, const LocalRay& r, double& t0, double& t1) {
+    const Vec3& inv = r.inverse();
+    if (r.hasZeroAxis()) return clipToBox(b, r.o, r.d, t0, t1);
+    if (b.lo.x > b.hi.x) return false;  // empty
+    double lo = t0, hi = t1;
+    // Per axis, as `if (a > c) swap(a, c)`, `if (a > lo) lo = a`, `if (c < hi) hi = c` but
+    // without branches: SSE2's min and max return their second operand when the first
+    // comparison fails, as these do (also for NaN, which a subnormal d can give).
+#if defined(__SSE2__)
+    {
+        const __m128d o = _mm_loadu_pd(&r.o.x), iv = _mm_loadu_pd(&inv.x);
+        const __m128d a = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(&b.lo.x), o), iv);
+        const __m128d c = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(&b.hi.x), o), iv);
+        const __m128d near = _mm_min_pd(c, a), far = _mm_max_pd(a, c);
+        const __m128d l = _mm_max_pd(near, _mm_set1_pd(lo));
+        const __m128d h = _mm_min_pd(far, _mm_set1_pd(hi));
+        const double lx = _mm_cvtsd_f64(l), ly = _mm_cvtsd_f64(_mm_unpackhi_pd(l, l));
+        const double hx = _mm_cvtsd_f64(h), hy = _mm_cvtsd_f64(_mm_unpackhi_pd(h, h));
+        lo = ly > lx ? ly : lx;
+        hi = hy < hx ? hy : hx;
+    }
+#else
+    for (int i = 0; i < 2; ++i) {
+        const double a = (b.lo[i] - r.o[i]) * inv[i], c = (b.hi[i] - r.o[i]) * inv[i];
+        const double near = a > c ? c : a, far = a > c ? a : c;
+        lo = near > lo ? near : lo;
+        hi = far < hi ? far : hi;
+    }
+#endif
+    const double a = (b.lo.z - r.o.z) * inv.z, c = (b.hi.z - r.o.z) * inv.z;
+    const double near = a > c ? c : a, far = a > c ? a : c;
+    lo = near > lo ? near : lo;
+    hi = far < hi ? far : hi;
+    if (!(lo <= hi)) return false;
+    t0 = lo;
+    t1 = hi;
+    return true;
+}
+
 // The first hit among a union's operands. `entry(i, t0)` sets t0 to where the ray enters
 // operand i's box within [tmin, tmax] and returns false when it misses the box;
 // `first(i, tmax, hit)` looks for a nearer surface in operand i. `order` is scratch space
@@ -70,6 +139,33 @@ inline bool clipToBox(const Box& b, const Vec3& o, const Vec3& d, double& t0, do
 template <class Entry, class First>
 bool firstOfUnion(uint32_t count, double tmin, double& tmax, Hit& hit, bool anyHit,
                   std::vector<std::pair<double, uint32_t>>& order, Entry entry, First first) {
+    // Few operands (a BVH node's two halves, most unions of a derivation): sorted by
+    // insertion on the stack, in the same order as std::sort gives below (by entry, then
+    // by operand: the pairs are distinct, so the sorted order is unique).
+    constexpr uint32_t kFew = 8;
+    if (count <= kFew) {
+        struct Entered {
+            double t0;
+            uint32_t i;
+        } few[kFew];  // (left uninitialised: filled below as far as it is read)
+        uint32_t m = 0;
+        for (uint32_t i = 0; i < count; ++i) {
+            double t0 = tmin;
+            if (!entry(i, t0)) continue;
+            uint32_t k = m++;
+            for (; k > 0 && few[k - 1].t0 > t0; --k) few[k] = few[k - 1];
+            few[k] = {t0, i};
+        }
+        bool found = false;
+        for (uint32_t k = 0; k < m; ++k) {
+            if (few[k].t0 > tmax) break;  // (at tmax exactly it may still win a tie)
+            if (first(few[k].i, tmax, hit)) {
+                found = true;
+                if (anyHit) break;
+            }
+        }
+        return found;
+    }
     const size_t base = order.size();
     for (uint32_t i = 0; i < count; ++i) {
         double t0 = tmin;

@@ -72,16 +72,25 @@ double aaEncode(double c) {
     return c > 0 ? std::pow(c, 1.0 / 2.5) : 0.0;
 }
 
-double colourDistance(const float* a, const float* b) {
+// The distance of two pixels' colours already encoded by aaEncode.
+double colourDistance(const double* a, const double* b) {
     double d = 0;
-    for (int k = 0; k < 3; ++k) d += std::fabs(aaEncode(a[k]) - aaEncode(b[k]));
+    for (int k = 0; k < 3; ++k) d += std::fabs(a[k] - b[k]);
     return d;
 }
 
 struct Worker {
     explicit Worker(const TraceScene& s) : shader(s) {}
     Shader shader;
+    // Adaptive sampling: the pass-1 colours of the tile being supersampled and of its
+    // border, encoded by aaEncode (`pass` names the pass they belong to).
+    std::vector<double> encoded;
+    Region tile{0, 0, 0, 0}, area{0, 0, 0, 0};
+    uint64_t pass = 0;
 };
+
+// Each adaptive pass of a TileRender, numbered (workers outlive a render).
+std::atomic<uint64_t> adaptivePasses{0};
 
 using Workers = tbb::enumerable_thread_specific<std::unique_ptr<Worker>>;
 
@@ -120,8 +129,9 @@ class TileRender {
         forTiles(1, halo_, [&](Worker& wk, int x, int y) { samplePixel(wk, x, y); });
         if (opt_.adaptive > 0 && !stop_) {
             const std::vector<float> centres = rgb_;
+            const uint64_t pass = ++adaptivePasses;
             forTiles(2, region_,
-                     [&](Worker& wk, int x, int y) { supersamplePixel(wk, centres, x, y); });
+                     [&](Worker& wk, int x, int y) { supersamplePixel(wk, centres, pass, x, y); });
         }
         if (firstError_) std::rethrow_exception(firstError_);
         if (stop_) throw RenderCancelled();
@@ -195,7 +205,8 @@ class TileRender {
         return rgb.data() +
                (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
     }
-    const float* pixelAt(const std::vector<float>& rgb, int x, int y) const {
+    template <class T>
+    const T* pixelAt(const std::vector<T>& rgb, int x, int y) const {
         return rgb.data() +
                (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
     }
@@ -216,15 +227,45 @@ class TileRender {
         store(x, y, sum / static_cast<double>(aa * aa));
     }
 
+    // The pass-1 colours encoded by aaEncode (each pixel is compared with up to four
+    // neighbours): once per pixel of the tile of (x, y) and its border, kept by the worker
+    // while it supersamples that tile (a few KB, not a copy of the image).
+    const double* encodedTile(Worker& wk, const std::vector<float>& centres, uint64_t pass, int x,
+                              int y) const {
+        const Region& t = wk.tile;
+        if (wk.pass != pass || x < t.x0 || x >= t.x1 || y < t.y0 || y >= t.y1) {
+            const int x0 = region_.x0 + (x - region_.x0) / kTile * kTile;
+            const int y0 = region_.y0 + (y - region_.y0) / kTile * kTile;
+            wk.pass = pass;
+            wk.tile = Region{x0, y0, x0 + kTile, y0 + kTile};
+            wk.area =
+                Region{std::max(halo_.x0, x0 - 1), std::max(halo_.y0, y0 - 1),
+                       std::min(halo_.x1, x0 + kTile + 1), std::min(halo_.y1, y0 + kTile + 1)};
+            wk.encoded.resize(wk.area.pixels() * 3);
+            double* e = wk.encoded.data();
+            for (int v = wk.area.y0; v < wk.area.y1; ++v) {
+                const float* c = pixelAt(centres, wk.area.x0, v);
+                for (int k = 0; k < wk.area.width() * 3; ++k) *e++ = aaEncode(c[k]);
+            }
+        }
+        return wk.encoded.data();
+    }
+
     // Pass 2 of adaptive sampling (POV-Ray's +A, method 1): a pixel whose centre differs
     // from a 4-neighbour's by the threshold or more gets depth x depth more samples.
-    void supersamplePixel(Worker& wk, const std::vector<float>& centres, int x, int y) {
+    void supersamplePixel(Worker& wk, const std::vector<float>& centres, uint64_t pass, int x,
+                          int y) {
         const float* c = pixelAt(centres, x, y);
+        const double* encoded = encodedTile(wk, centres, pass, x, y);
+        auto at = [&](int px, int py) {  // (the neighbours of the tile's pixels are in area)
+            return encoded +
+                   (static_cast<size_t>(py - wk.area.y0) * wk.area.width() + (px - wk.area.x0)) * 3;
+        };
         bool differs = false;
         const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
         for (int k = 0; k < 4 && !differs; ++k) {
             if (nx[k] < 0 || nx[k] >= w_ || ny[k] < 0 || ny[k] >= h_) continue;
-            differs = colourDistance(c, pixelAt(centres, nx[k], ny[k])) >= opt_.adaptive;
+            differs = colourDistance(at(x, y), at(nx[k], ny[k])) >= opt_.adaptive;
         }
         if (!differs) return;
         const int depth = std::max(1, opt_.adaptiveDepth);

@@ -114,14 +114,21 @@ size_t TraceScene::stackBytesNeeded() const {
 
 Tracer::FrameStack::FrameStack(size_t frameSize)
     : frameSize_(std::max<size_t>(frameSize, 1)),
-      perBlock_(std::max<size_t>(4096 / frameSize_, 16)) {}
+      perBlock_(std::max<size_t>(4096 / frameSize_, 16)),
+      slot_(perBlock_) {}
 
-double* Tracer::FrameStack::push() {
+// The top block is full (or there is none): the next one, made the first time.
+void Tracer::FrameStack::nextBlock() {
     const size_t b = used_ / perBlock_;
     if (b == blocks_.size()) blocks_.push_back(std::make_unique<double[]>(perBlock_ * frameSize_));
-    double* f = blocks_[b].get() + (used_ % perBlock_) * frameSize_;
-    ++used_;
-    return f;
+    block_ = blocks_[b].get();
+    slot_ = 0;
+}
+
+// The top block became empty: the one below it, full.
+void Tracer::FrameStack::previousBlock() {
+    slot_ = perBlock_;
+    block_ = used_ == 0 ? nullptr : blocks_[used_ / perBlock_ - 1].get();
 }
 
 Tracer::Tracer(const TraceScene& scene)
@@ -153,21 +160,22 @@ bool Tracer::selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t de
                           double tmax) {
     if (!scene_.useBounds) return false;
     double t0 = tmin, t1 = tmax;
-    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r.o, r.d, t0, t1)) return true;
+    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r, t0, t1)) return true;
     const InstanceBoxes* boxes = scene_.instanceBoxes_.get();
     if (!boxes || !boxes->useAt(n, depth)) return false;
     const Box exact = boxes->box(*boxWorker_, n, depth, c.frame, c.path);
-    return !clipToBox(exact, r.o, r.d, t0, t1);
+    return !clipToBox(exact, r, t0, t1);
 }
 
-void Tracer::checkStack() {
-    const auto here = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));
-    if (here < lowWater_) lowWater_ = here;
-    if (stackLimit_ == 0) stackLimit_ = threadStackLimit();
-    if (here < stackLimit_)
-        throw StackExhausted(fmt::format(
-            "the ray tracer's stack is too small for this scene's recursion depth (max_depth {})",
-            g_.scene.settings.maxDepth));
+// The walk is below stackLimit_: learns the limit the first time, else throws.
+void Tracer::checkStackLimit(uintptr_t here) {
+    if (stackLimit_ == UINTPTR_MAX) {
+        stackLimit_ = threadStackLimit();
+        if (here >= stackLimit_) return;
+    }
+    throw StackExhausted(fmt::format(
+        "the ray tracer's stack is too small for this scene's recursion depth (max_depth {})",
+        g_.scene.settings.maxDepth));
 }
 
 bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
@@ -311,7 +319,7 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 [&](uint32_t i, double& t0) {
                     double t1 = tmax;
                     return !scene_.useBounds ||
-                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, t0, t1);
+                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r, t0, t1);
                 },
                 [&](uint32_t i, double& best, Hit& h) {
                     return first(g_.child(n, i), r, Semantics::operand(c, i), tmin, best, h);
@@ -384,7 +392,7 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
                 node.op(), node.childCount, spans_, tmin, tmax,
                 [&](uint32_t i, double lo, double hi) {
                     return !scene_.useBounds ||
-                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r.o, r.d, lo, hi);
+                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r, lo, hi);
                 },
                 [&](uint32_t i, double lo, double hi) {
                     return spans(g_.child(n, i), r, Semantics::operand(c, i), lo, hi);

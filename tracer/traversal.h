@@ -175,14 +175,27 @@ class Tracer {
     class FrameStack {
       public:
         explicit FrameStack(size_t frameSize);
-        double* push();
-        void pop() { --used_; }
-        void reset() { used_ = 0; }
+        double* push() {  // (inline: once per C-node visit)
+            if (slot_ == perBlock_) nextBlock();
+            ++used_;
+            return block_ + slot_++ * frameSize_;
+        }
+        void pop() {
+            --used_;
+            if (--slot_ == 0) previousBlock();
+        }
+        void reset() { used_ = 0, slot_ = perBlock_, block_ = nullptr; }
 
       private:
+        void nextBlock();
+        void previousBlock();
         size_t frameSize_, perBlock_;
         std::vector<std::unique_ptr<double[]>> blocks_;
         size_t used_ = 0;
+        // The block of the top frame and the frames in it (with no frame: none, and
+        // perBlock_, so that the first push moves to block 0).
+        double* block_ = nullptr;
+        size_t slot_;
     };
 
     bool first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit);
@@ -198,7 +211,12 @@ class Tracer {
     auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
                Unrolled unrolled, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
-    void checkStack();
+    void checkStack() {  // (inline: once per S-node visit)
+        const auto here = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));
+        if (here < lowWater_) lowWater_ = here;
+        if (here < stackLimit_) checkStackLimit(here);
+    }
+    [[gnu::noinline]] void checkStackLimit(uintptr_t here);
     Affine paintMapHere(uint32_t material) const;
 
     const TraceScene& scene_;
@@ -220,7 +238,7 @@ class Tracer {
     std::vector<Affine> paintMaps_;
     bool anyHit_ = false;
     uint64_t visits_ = 0;
-    uintptr_t stackLimit_ = 0;
+    uintptr_t stackLimit_ = UINTPTR_MAX;  // not yet known (0: unknown to the system)
     uintptr_t lowWater_ = UINTPTR_MAX;
 };
 

@@ -315,7 +315,7 @@ bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
                              bool anyHit, Scratch& s) const {
     if (root_ == kNone) return false;
     double t0 = tmin, t1 = tmax;
-    if (!clipToBox(nodes_[root_].box, r.o, r.d, t0, t1)) return false;
+    if (!clipToBox(nodes_[root_].box, r, t0, t1)) return false;
     return firstAt(root_, r, tmin, tmax, hit, use, anyHit, s);
 }
 
@@ -323,7 +323,7 @@ size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
                                std::vector<Span>& spans, const Use& use, Scratch& s) const {
     if (root_ == kNone) return 0;
     double t0 = tmin, t1 = tmax;
-    if (!clipToBox(nodes_[root_].box, r.o, r.d, t0, t1)) return 0;
+    if (!clipToBox(nodes_[root_].box, r, t0, t1)) return 0;
     return spansAt(root_, r, tmin, tmax, spans, use, s);
 }
 
@@ -400,7 +400,7 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         count, tmin, tmax, hit, anyHit, s.order,
         [&](uint32_t i, double& t0) {
             double t1 = tmax;
-            return clipToBox(nodes_[list[i]].box, r.o, r.d, t0, t1);
+            return clipToBox(nodes_[list[i]].box, r, t0, t1);
         },
         [&](uint32_t i, double& best, Hit& h) {
             return firstAt(list[i], r, tmin, best, h, use, anyHit, s);
@@ -417,7 +417,7 @@ bool UnrolledInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, doub
         2, tmin, tmax, hit, anyHit, s.order,
         [&](uint32_t i, double& t0) {
             double t1 = tmax;
-            return clipToBox(bvh_[halves[i]].box, r.o, r.d, t0, t1);
+            return clipToBox(bvh_[halves[i]].box, r, t0, t1);
         },
         [&](uint32_t i, double& best, Hit& h) {
             return firstBvh(halves[i], r, tmin, best, h, use, anyHit, s);
@@ -450,7 +450,7 @@ size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
             count = combineOperands(
                 node.op, node.count, spans, tmin, tmax,
                 [&](uint32_t i, double lo, double hi) {
-                    return clipToBox(nodes_[children_[node.first + i]].box, rr.o, rr.d, lo, hi);
+                    return clipToBox(nodes_[children_[node.first + i]].box, rr, lo, hi);
                 },
                 [&](uint32_t i, double lo, double hi) {
                     return spansAt(children_[node.first + i], rr, lo, hi, spans, use, s);

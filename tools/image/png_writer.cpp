@@ -4,6 +4,8 @@
 #include <png.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <csetjmp>
@@ -57,6 +59,9 @@ bool encode(FILE* file, int width, int height, const uint8_t* bytes, char* error
     software.key = const_cast<png_charp>("Software");
     software.text = const_cast<png_charp>("pcsg");
     png_set_text(png, info, &software, 1);
+    // zlib's fastest level: the same pixels in a file about 5% larger (renders compress
+    // well), encoded with 30% fewer instructions, on one thread after the render's all.
+    png_set_compression_level(png, 1);
     png_write_info(png, info);
     const size_t stride = static_cast<size_t>(width) * 3;
     for (int y = 0; y < height; ++y) png_write_row(png, bytes + static_cast<size_t>(y) * stride);
@@ -67,10 +72,57 @@ bool encode(FILE* file, int width, int height, const uint8_t* bytes, char* error
 
 }  // namespace
 
+namespace {
+
+uint8_t srgbByte(float linear) {
+    return static_cast<uint8_t>(std::lround(srgbEncode(linear) * 255.0));
+}
+
+// srgbByte by table: for each byte k > 0 the smallest float in (0, 1) that gives k or
+// more, found by bisecting the floats' bit patterns (which order the positive floats) with
+// srgbByte itself; a value's byte is then the number of thresholds at or below it, counted
+// from the byte at the start of its bucket (the floats with the same top 16 bits), which
+// mostly is the answer. The same bytes as srgbByte, which rises with its argument, for 255
+// x 30 calls of pow instead of three per pixel.
+class SrgbTable {
+  public:
+    SrgbTable() {
+        for (int k = 1; k < 256; ++k) {
+            uint32_t lo = 0, hi = kOne;  // srgbByte(1) = 255
+            while (lo < hi) {
+                const uint32_t mid = lo + (hi - lo) / 2;
+                if (srgbByte(std::bit_cast<float>(mid)) >= k)
+                    hi = mid;
+                else
+                    lo = mid + 1;
+            }
+            threshold_[k - 1] = std::bit_cast<float>(lo);
+        }
+        for (uint32_t b = 0; b < kBuckets; ++b)
+            start_[b] = static_cast<uint8_t>(
+                std::upper_bound(threshold_, threshold_ + 255, std::bit_cast<float>(b << 16)) -
+                threshold_);
+    }
+    uint8_t operator()(float linear) const {
+        if (!(linear > 0) || linear >= 1) return srgbByte(linear);  // 0 (also NaN) or 255
+        uint32_t k = start_[std::bit_cast<uint32_t>(linear) >> 16];
+        while (k < 255 && threshold_[k] <= linear) ++k;
+        return static_cast<uint8_t>(k);
+    }
+
+  private:
+    static constexpr uint32_t kOne = 0x3f800000;  // the bits of 1.0f
+    static constexpr uint32_t kBuckets = (kOne >> 16) + 1;
+    float threshold_[255];
+    uint8_t start_[kBuckets];
+};
+
+}  // namespace
+
 std::vector<uint8_t> srgbBytes(std::span<const float> rgb) {
+    static const SrgbTable table;
     std::vector<uint8_t> bytes(rgb.size());
-    for (size_t i = 0; i < rgb.size(); ++i)
-        bytes[i] = static_cast<uint8_t>(std::lround(srgbEncode(rgb[i]) * 255.0));
+    for (size_t i = 0; i < rgb.size(); ++i) bytes[i] = table(rgb[i]);
     return bytes;
 }
 

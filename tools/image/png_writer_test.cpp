@@ -6,11 +6,13 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "cli_test_util.h"
+#include "image_format.h"
 #include "image_test_util.h"
 
 namespace pcsg::tools {
@@ -27,6 +29,31 @@ const std::vector<uint8_t> k8Bit = {0, 188, 255, 124, 255, 0, 3, 63, 188};
 
 TEST(PngWriter, EncodesEightBitSrgb) {
     EXPECT_EQ(srgbBytes(kPixels), k8Bit);
+}
+
+// srgbBytes converts by a table of thresholds: the same bytes as the formula (the 8-bit
+// value rounded from srgbEncode), checked on 2^20 values spread over [0, 1] and on both
+// floats beside every 1/510th (where the rounding steps), whatever the table holds.
+TEST(PngWriter, TheTableGivesTheFormulasBytes) {
+    std::vector<float> values;
+    for (int i = 0; i <= (1 << 20); ++i) values.push_back(static_cast<float>(i) / (1 << 20));
+    for (int k = 0; k <= 510; ++k) {
+        // the linear value whose encoding is k / 510, and the floats just around it
+        const double e = k / 510.0;
+        const float v =
+            static_cast<float>(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
+        float below = v, above = v;
+        for (int step = 0; step < 8; ++step) {
+            below = std::nextafter(below, 0.0f);
+            above = std::nextafter(above, 2.0f);
+            values.insert(values.end(), {below, v, above});
+        }
+    }
+    const std::vector<uint8_t> bytes = srgbBytes(values);
+    size_t wrong = 0;
+    for (size_t i = 0; i < values.size(); ++i)
+        wrong += bytes[i] != static_cast<uint8_t>(std::lround(srgbEncode(values[i]) * 255.0));
+    EXPECT_EQ(wrong, 0u);
 }
 
 TEST(PngWriter, OpenImageIOReadsBackWhatWasWritten) {
