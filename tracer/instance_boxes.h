@@ -29,6 +29,10 @@
 //    are already exact), that depth goes back to the static box alone. Culling with a
 //    looser box is still sound and the tracer breaks ties between equally near hits by
 //    their instance path, so images do not depend on these decisions.
+//  - Filled ahead of need (prefill): before the first tile, the instances at the
+//    shallowest depth where there are a few dozen of them are unrolled in parallel, so
+//    that a large object's boxes are in the table when the first rays arrive (before,
+//    every thread's first ray unrolled the same top instance, the whole terrain, at once).
 //  - Thread-safe: shards with reader-writer locks; any number of tracers share one.
 #pragma once
 
