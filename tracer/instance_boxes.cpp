@@ -1,6 +1,9 @@
 // Exact boxes of S-node instances: see instance_boxes.h.
 #include "instance_boxes.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <tbb/spin_rw_mutex.h>
 
 #include <bit>
@@ -173,21 +176,23 @@ class BoxSink {
     // An S-node instance met inside the one being unrolled.
     bool lookup(NodeId n, uint32_t, const double* frame, uint64_t path, Result& out) {
         InstanceBoxes::Stored s;
-        if (boxes_.find(boxes_.keyOf(n, frame, path), s)) {
+        const InstanceBoxes::Key k = boxes_.keyOf(n, frame, path);
+        if (boxes_.find(k, s)) {
             out = {s.box, s.weight};
             visits_ += s.weight;  // it stands for that many visits
             return true;
         }
-        starts_.push_back(visits_);
+        starts_.push_back({visits_, k});
         return false;
     }
-    void store(NodeId n, uint32_t, const double* frame, uint64_t path, Result& r) {
+    void store(NodeId, uint32_t, const double*, uint64_t, Result& r) {
         // Every visit below this S-node, including the ones its stored parts stand for.
-        r.weight = visits_ - starts_.back();
+        r.weight = visits_ - starts_.back().visits;
+        const InstanceBoxes::Key k = starts_.back().key;
         starts_.pop_back();
         r.box = storable(r.box);
         if (r.weight >= boxes_.opt_.minWeight)
-            boxes_.insert(boxes_.keyOf(n, frame, path), InstanceBoxes::Stored{r.box, r.weight});
+            boxes_.insert(k, InstanceBoxes::Stored{r.box, r.weight});
     }
 
     Result toParent(const Affine& m, const Result& local) const {
@@ -211,7 +216,11 @@ class BoxSink {
   private:
     const InstanceBoxes& boxes_;
     uint64_t visits_ = 0;
-    std::vector<uint64_t> starts_;  // visits_ when each open S-node instance began
+    struct Open {
+        uint64_t visits;  // visits_ when the S-node instance began
+        InstanceBoxes::Key key;
+    };
+    std::vector<Open> starts_;  // the open S-node instances, innermost last
 };
 
 class InstanceBoxes::Worker {
@@ -273,18 +282,23 @@ bool InstanceBoxes::unrollAt(NodeId select, uint32_t depth) const {
     return expand_[i].load(std::memory_order_relaxed) != 0;
 }
 
+// Two lanes of xxHash64's round (acc = rotl(acc + v * P2, 31) * P1), each with its own
+// constants, finished with SplitMix64's finaliser: one multiplication per value on each
+// lane's dependency chain, where a full finaliser per value took three.
 InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint64_t path) const {
+    constexpr uint64_t P1 = 0x9e3779b185ebca87ULL, P2 = 0xc2b2ae3d27d4eb4fULL;
+    constexpr uint64_t P3 = 0x165667b19e3779f9ULL, P4 = 0x85ebca77c2b2ae63ULL;
     const ModuleDependencies& d = deps_[g_.nodes[select].payload];
-    uint64_t a = mix(0x84222325cbf29ce4ULL ^ select), b = mix(0x2545f4914f6cdd1dULL + select);
-    for (Slot s : d.reads) {
-        const uint64_t v = std::bit_cast<uint64_t>(frame[s]);
-        a = mix(a ^ v);
-        b = mix(b + v * 0x9e3779b97f4a7c15ULL);
-    }
-    if (d.usesPath) {
-        a = mix(a ^ path);
-        b = mix(b + path * 0xc2b2ae3d27d4eb4fULL);
-    }
+    uint64_t a = 0x84222325cbf29ce4ULL ^ (select * P1), b = 0x2545f4914f6cdd1dULL + select * P3;
+    auto round = [&](uint64_t v) {
+        a = std::rotl(a + v * P2, 31) * P1;
+        b = std::rotl(b + v * P4, 29) * P3;
+    };
+    for (Slot s : d.reads) round(std::bit_cast<uint64_t>(frame[s]));
+    if (d.usesPath) round(path);
+    const uint64_t n = d.reads.size() + (d.usesPath ? 1 : 0);
+    a = mix(a ^ n);
+    b = mix(b ^ std::rotl(a, 32));
     return {a | 1, b};  // a != 0: never the empty slot
 }
 
@@ -325,24 +339,132 @@ void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const
     }
 }
 
-Box InstanceBoxes::box(Worker& w, NodeId select, uint32_t depth, const double* frame,
+Box InstanceBoxes::box(Worker& w, const Key& k, NodeId select, uint32_t depth, const double* frame,
                        uint64_t path) const {
-    const Key k = keyOf(select, frame, path);
     Stored s;
-    if (!table_->find(k, s)) {
-        computed_.fetch_add(1, std::memory_order_relaxed);
-        w.sink.reset();
-        WalkStart start;
-        start.node = select;
-        start.frame = frame;
-        start.path = path;
-        start.depth = depth > 0 ? depth - 1 : 0;  // the walk counts this S-node itself
-        const BoxResult r = w.walker.run(start, /*annotateStart=*/false);
-        s.box = r.box;
-        s.weight = r.weight;
-    }
+    if (!table_->find(k, s)) s = unroll(w, select, depth, frame, path);
     record(select, depth, s);
     return paddedBox(s.box);
+}
+
+InstanceBoxes::Stored InstanceBoxes::unroll(Worker& w, NodeId select, uint32_t depth,
+                                            const double* frame, uint64_t path) const {
+    computed_.fetch_add(1, std::memory_order_relaxed);
+    w.sink.reset();
+    WalkStart start;
+    start.node = select;
+    start.frame = frame;
+    start.path = path;
+    start.depth = depth > 0 ? depth - 1 : 0;  // the walk counts this S-node itself
+    const BoxResult r = w.walker.run(start, /*annotateStart=*/false);
+    return Stored{r.box, r.weight};
+}
+
+// ---------------------------------------------------------------------------------------
+// Filling ahead of need.
+
+struct InstanceBoxes::Seed {
+    NodeId node;
+    uint32_t depth;
+    uint64_t path;
+    std::vector<double> frame;
+};
+
+namespace {
+struct StopSeeding {};
+}  // namespace
+
+// A walk from the start that collects the distinct S-node instances at one depth (and
+// goes no deeper), within a visit limit.
+class SeedSink {
+  public:
+    struct Result {};
+    SeedSink(const InstanceBoxes& boxes, uint32_t depth, uint64_t maxVisits)
+        : boxes_(boxes), depth_(depth), maxVisits_(maxVisits) {}
+
+    Result nothing() const { return {}; }
+    void visit() {
+        if (++visits_ > maxVisits_) throw StopSeeding{};
+    }
+    bool lookup(NodeId n, uint32_t depth, const double* frame, uint64_t path, Result&) {
+        if (depth + 1 < depth_) return false;
+        if (!boxes_.useAt(n, depth + 1)) return true;  // (an unanalysed module: not keyed)
+        const InstanceBoxes::Key k = boxes_.keyOf(n, frame, path);
+        for (const InstanceBoxes::Key& seen : keys_)
+            if (seen == k) return true;
+        keys_.push_back(k);
+        const size_t slots = boxes_.g_.slotCount();
+        seeds.push_back({n, depth + 1, path, std::vector<double>(frame, frame + slots)});
+        if (seeds.size() > kMaxSeeds) throw StopSeeding{};
+        return true;
+    }
+    void store(NodeId, uint32_t, const double*, uint64_t, const Result&) {}
+    Result primitive(PrimitiveKind, const Affine&, uint32_t, const double*, uint32_t) const {
+        return {};
+    }
+    void beginOperator(WalkEntry&) {}
+    Result endOperator(CsgOp, const Result*, uint32_t, const WalkEntry&) const { return {}; }
+
+    static constexpr size_t kMaxSeeds = 4096;
+    std::vector<InstanceBoxes::Seed> seeds;
+
+  private:
+    const InstanceBoxes& boxes_;
+    const uint32_t depth_;
+    const uint64_t maxVisits_;
+    uint64_t visits_ = 0;
+    std::vector<InstanceBoxes::Key> keys_;
+};
+
+std::vector<InstanceBoxes::Seed> InstanceBoxes::seedsAt(NodeId start, uint32_t depth,
+                                                        uint64_t maxVisits) const {
+    SeedSink sink(*this, depth, maxVisits);
+    Walker<SeedSink> walker(sem_, sink);
+    WalkStart from;
+    from.node = start;
+    try {
+        walker.run(from);
+    } catch (const StopSeeding&) {
+        return {};
+    } catch (const RuntimeError&) {
+        return {};
+    }
+    return std::move(sink.seeds);
+}
+
+void InstanceBoxes::prefill(NodeId start, const std::atomic<bool>* cancel) const {
+    // Enough instances to share out among the threads, found by a walk of the levels
+    // above them (a few thousand visits at most).
+    constexpr size_t kEnough = 64;
+    constexpr uint64_t kMaxVisits = 1u << 20;
+    std::vector<Seed> seeds;
+    for (uint32_t depth = 1; depth + 1 < levels_ && seeds.size() < kEnough; ++depth) {
+        std::vector<Seed> deeper = seedsAt(start, depth, kMaxVisits);
+        if (deeper.size() <= seeds.size()) break;
+        seeds = std::move(deeper);
+    }
+    if (seeds.size() < 2) return;
+    tbb::enumerable_thread_specific<WorkerPtr> workers([this] { return makeWorker(); });
+    std::atomic<bool> stop{false};
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, seeds.size(), 1),
+        [&](const tbb::blocked_range<size_t>& range) {
+            Worker& w = *workers.local();
+            for (size_t i = range.begin(); i != range.end(); ++i) {
+                if (stop.load(std::memory_order_relaxed) ||
+                    (cancel && cancel->load(std::memory_order_relaxed)))
+                    return;
+                const Seed& sd = seeds[i];
+                Stored s;
+                if (table_->find(keyOf(sd.node, sd.frame.data(), sd.path), s)) continue;
+                try {
+                    unroll(w, sd.node, sd.depth, sd.frame.data(), sd.path);
+                } catch (const RuntimeError&) {
+                    stop = true;
+                }
+            }
+        },
+        tbb::simple_partitioner());
 }
 
 InstanceBoxStats InstanceBoxes::stats() const {

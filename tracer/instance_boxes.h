@@ -29,6 +29,10 @@
 //    are already exact), that depth goes back to the static box alone. Culling with a
 //    looser box is still sound and the tracer breaks ties between equally near hits by
 //    their instance path, so images do not depend on these decisions.
+//  - Filled ahead of need (prefill): before the first tile, the instances at the
+//    shallowest depth where there are a few dozen of them are unrolled in parallel, so
+//    that a large object's boxes are in the table when the first rays arrive (before,
+//    every thread's first ray unrolled the same top instance, the whole terrain, at once).
 //  - Thread-safe: shards with reader-writer locks; any number of tracers share one.
 #pragma once
 
@@ -100,18 +104,37 @@ class InstanceBoxes {
     // The box of the S-node instance (select, frame, path) in the S-node's own frame,
     // padded like every box the tracer tests. Throws RuntimeError (without this S-node
     // in its module path: the caller adds it) when unrolling meets a run-time error.
-    Box box(Worker& w, NodeId select, uint32_t depth, const double* frame, uint64_t path) const;
+    Box box(Worker& w, NodeId select, uint32_t depth, const double* frame, uint64_t path) const {
+        return box(w, keyOf(select, frame, path), select, depth, frame, path);
+    }
+    // The same, with the instance's key computed by the caller.
+    Box box(Worker& w, const Key& k, NodeId select, uint32_t depth, const double* frame,
+            uint64_t path) const;
+
+    // Fills the table ahead of need, in parallel on the calling thread's oneTBB pool: the
+    // S-node instances at the shallowest depth below `start` (the axiom) where there are
+    // enough of them to share out, each unrolled on a thread of its own, so that the
+    // first rays find the boxes of a large object (a terrain) in the table instead of
+    // all unrolling the same top instance at once. Their boxes are the numbers the rays'
+    // misses would compute. A run-time error stops it quietly (the render meets the error
+    // itself), and so does `cancel`. Does not take part in the trials of useAt/unrollAt.
+    void prefill(NodeId start, const std::atomic<bool>* cancel = nullptr) const;
 
     InstanceBoxStats stats() const;
 
   private:
     friend class BoxSink;
+    friend class SeedSink;
+    struct Seed;
+    std::vector<Seed> seedsAt(NodeId start, uint32_t depth, uint64_t maxVisits) const;
     struct Stored {
         Box box;
         uint64_t weight = 0;
     };
     class Table;
 
+    Stored unroll(Worker& w, NodeId select, uint32_t depth, const double* frame,
+                  uint64_t path) const;
     bool find(const Key& k, Stored& out) const;
     void insert(const Key& k, const Stored& s) const;
     void record(NodeId select, uint32_t depth, const Stored& s) const;

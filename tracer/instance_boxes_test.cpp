@@ -192,6 +192,79 @@ TEST(InstanceBoxes, TheBoxDoesNotDependOnWhatTheCacheHeld) {
     }
 }
 
+// Every S-node instance's box from `a` and from `b` (recursively: small systems only).
+void expectSameBoxes(const Graph& g, const InstanceBoxes& a, const InstanceBoxes& b) {
+    auto wa = a.makeWorker(), wb = b.makeWorker();
+    size_t checks = 0;
+    auto walk = [&](auto&& self, NodeId n, const std::vector<double>& frame, uint64_t path,
+                    uint32_t depth) -> void {
+        const Node& node = g.nodes[n];
+        const EvalState st{frame.data(), path};
+        if (node.kind == NodeKind::Select) {
+            ++depth;
+            ++checks;
+            EXPECT_EQ(a.box(*wa, n, depth, frame.data(), path),
+                      b.box(*wb, n, depth, frame.data(), path));
+            const uint32_t r = selectRule(g, n, st);
+            return self(self, g.child(n, r), frame, pathRule(path, r), depth);
+        }
+        if (node.kind == NodeKind::Calc) {
+            std::vector<double> next(g.slotCount());
+            applyCalc(g, n, st, next.data());
+            return self(self, g.child(n), next, path, depth);
+        }
+        if (node.kind == NodeKind::Operator)
+            for (uint32_t i = 0; i < node.childCount; ++i)
+                self(self, g.child(n, i), frame, pathChild(path, i), depth);
+        if (node.kind == NodeKind::Transform || node.kind == NodeKind::Paint)
+            self(self, g.child(n), frame, path, depth);
+    };
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    walk(walk, g.axiom, frame, kRootPath, 0);
+    EXPECT_GT(checks, 0u);
+}
+
+TEST(InstanceBoxes, FillingAheadStoresTheBoxesTheMissesWouldCompute) {
+    for (const char* text : {kTree, kTerrain, kCsgPlant}) {
+        auto c = compile(text);
+        ASSERT_TRUE(c->graph);
+        const Graph& g = *c->graph;
+        const Bounds bounds = computeBounds(g);
+        InstanceBoxOptions none = always();
+        none.maxBytes = 0;  // nothing is ever stored: every box computed on its own
+        const InstanceBoxes cold(g, bounds, none), filled(g, bounds, always());
+        filled.prefill(g.axiom);
+        if (text == kTerrain) {  // (the tree's instances of a depth are all alike: one each)
+            const InstanceBoxStats ahead = filled.stats();
+            EXPECT_GT(ahead.entries, 0u);
+            EXPECT_GT(ahead.computed, 1u);  // several instances, shared out
+        }
+        expectSameBoxes(g, filled, cold);
+    }
+}
+
+TEST(InstanceBoxes, FillingAheadStopsQuietlyAtARunTimeError) {
+    // The rule number 3 of a module with two rules, deep inside: the fill stores what it
+    // finished and leaves the error to the render, which asks for the box and gets it.
+    auto c = compile(R"(
+{ n = 6 } T
+T if(n > 0, 2, if(n < -5, 1, 3))
+1: T -> sphere
+2: T -> {n = n-1} uscale(0.5) T ∪ {n = n-1} move(1,0,0) uscale(0.5) T
+)");
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Bounds bounds = computeBounds(g);
+    const InstanceBoxes boxes(g, bounds, always());
+    EXPECT_NO_THROW(boxes.prefill(g.axiom));
+    auto w = boxes.makeWorker();
+    std::vector<double> frame(g.slotCount()), f(g.slotCount());
+    initFrame(g, frame.data());
+    applyCalc(g, g.axiom, EvalState{frame.data(), kRootPath}, f.data());
+    EXPECT_THROW(boxes.box(*w, g.child(g.axiom), 1, f.data(), kRootPath), RuntimeError);
+}
+
 TEST(InstanceBoxes, TheTableStaysWithinItsByteLimit) {
     auto c = compile(kTerrain);
     ASSERT_TRUE(c->graph);

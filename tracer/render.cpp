@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -120,12 +121,14 @@ class TileRender {
 
     // Runs both passes on the calling thread's pool and returns the region's pixels;
     // rethrows the first error.
-    std::vector<float> run(size_t stackBytes) {
+    // `first` runs on the pool before the first tile.
+    std::vector<float> run(size_t stackBytes, const std::function<void()>& first) {
         std::unique_ptr<tbb::global_control> limit;
         if (opt_.threads > 0)
             limit = std::make_unique<tbb::global_control>(
                 tbb::global_control::max_allowed_parallelism, static_cast<size_t>(opt_.threads));
         tbb::global_control stackSize(tbb::global_control::thread_stack_size, stackBytes);
+        first();
         forTiles(1, halo_, [&](Worker& wk, int x, int y) { samplePixel(wk, x, y); });
         if (opt_.adaptive > 0 && !stop_) {
             const std::vector<float> centres = rgb_;
@@ -304,6 +307,14 @@ struct RegionRenderer::State {
     const PinholeCamera camera;
     Workers workers;
     RenderResult figures;  // no pixels
+    std::once_flag prefilled;
+    // The instance boxes filled ahead of the first region's rays (InstanceBoxes::prefill).
+    void prefill() {
+        std::call_once(prefilled, [this] {
+            const InstanceBoxes* boxes = scene.instanceBoxes();
+            if (boxes && scene.useBounds) boxes->prefill(scene.graph().axiom, opt.cancel);
+        });
+    }
 };
 
 namespace {
@@ -354,7 +365,11 @@ std::vector<float> RegionRenderer::render(const Region& region) {
     std::vector<float> rgb;
     // The walk recurses once per node visit: the calling thread gets a stack as large as
     // the scene needs, and so do the pool's threads.
-    auto work = [&] { rgb = TileRender(s.scene, s.camera, s.opt, s.workers, region).run(stack); };
+    auto work = [&] {
+        rgb = TileRender(s.scene, s.camera, s.opt, s.workers, region).run(stack, [&] {
+            s.prefill();
+        });
+    };
     runWithStack(stack, work);
     s.figures.seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -145,25 +145,45 @@ Tracer::Tracer(const TraceScene& scene)
 Tracer::~Tracer() = default;
 
 // The unrolled instance to trace instead of walking below S-node n, if there is one.
-const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t depth) {
+const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t depth,
+                                           std::optional<InstanceBoxes::Key>& key) {
     if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->unrollAt(n, depth))
         return nullptr;
-    const UnrolledInstance* x = expansion_->get(n, depth, c.frame, c.path);
+    if (!key) key = scene_.instanceBoxes_->keyOf(n, c.frame, c.path);
+    const UnrolledInstance* x = expansion_->get(*key, n, depth, c.frame, c.path);
     // Used only where its deepest S-node stays within max_depth (else the walk reports it).
     if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
     return x;
 }
 
+// The instance expanded already by this thread, if there is one: it is traced without its
+// exact box from the cache (which, for an instance too small to be stored there, would be
+// unrolled again), since the expansion clips rays to a box of its own.
+const UnrolledInstance* Tracer::builtAt(NodeId n, const Ctx& c, uint32_t depth,
+                                        std::optional<InstanceBoxes::Key>& key) {
+    if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->unrollAt(n, depth))
+        return nullptr;
+    key = scene_.instanceBoxes_->keyOf(n, c.frame, c.path);
+    const UnrolledInstance* x = expansion_->built(*key, n, depth);
+    if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
+    return x;
+}
+
 // Whether the ray misses the S-node n (at `depth`) within [tmin, tmax]: its box at that
-// depth, then, where it pays, the exact box of this instance.
-bool Tracer::selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
-                          double tmax) {
+// depth, then (exactCulled), where it pays, the exact box of this instance. The part of
+// [tmin, tmax] within the box is left in [t0, t1].
+bool Tracer::staticCulled(NodeId n, const LocalRay& r, uint32_t depth, double& t0, double& t1) {
+    return scene_.useBounds && !clipToBox(scene_.bounds_.select(g_, n, depth), r, t0, t1);
+}
+
+// The instance's key, when computed here, is left in `key` for unrolledAt.
+bool Tracer::exactCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double t0,
+                         double t1, std::optional<InstanceBoxes::Key>& key) {
     if (!scene_.useBounds) return false;
-    double t0 = tmin, t1 = tmax;
-    if (!clipToBox(scene_.bounds_.select(g_, n, depth), r, t0, t1)) return true;
     const InstanceBoxes* boxes = scene_.instanceBoxes_.get();
     if (!boxes || !boxes->useAt(n, depth)) return false;
-    const Box exact = boxes->box(*boxWorker_, n, depth, c.frame, c.path);
+    if (!key) key = boxes->keyOf(n, c.frame, c.path);
+    const Box exact = boxes->box(*boxWorker_, *key, n, depth, c.frame, c.path);
     return !clipToBox(exact, r, t0, t1);
 }
 
@@ -240,8 +260,12 @@ template <class Below, class Unrolled, class TransformBack>
         try {
             const uint32_t depth = sem.selectDepth(n, c);
             checkStack();
-            if (selectCulled(n, r, c, depth, tmin, tmax)) return Result{};
-            if (const UnrolledInstance* x = unrolledAt(n, c, depth)) return unrolled(*x, c);
+            double t0 = tmin, t1 = tmax;
+            if (staticCulled(n, r, depth, t0, t1)) return Result{};
+            std::optional<InstanceBoxes::Key> key;
+            if (const UnrolledInstance* x = builtAt(n, c, depth, key)) return unrolled(*x, c);
+            if (exactCulled(n, r, c, depth, t0, t1, key)) return Result{};
+            if (const UnrolledInstance* x = unrolledAt(n, c, depth, key)) return unrolled(*x, c);
             const Step st = sem.enter(n, c, scratch);
             return below(st.child, r, st.state);
         } catch (RuntimeError& e) {

@@ -42,6 +42,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -204,9 +205,13 @@ class Tracer {
     bool firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
                       Hit& hit);
     size_t spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax);
-    bool selectCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double tmin,
-                      double tmax);
-    const UnrolledInstance* unrolledAt(NodeId n, const Ctx& c, uint32_t depth);
+    bool staticCulled(NodeId n, const LocalRay& r, uint32_t depth, double& t0, double& t1);
+    bool exactCulled(NodeId n, const LocalRay& r, const Ctx& c, uint32_t depth, double t0,
+                     double t1, std::optional<InstanceBoxes::Key>& key);
+    const UnrolledInstance* builtAt(NodeId n, const Ctx& c, uint32_t depth,
+                                    std::optional<InstanceBoxes::Key>& key);
+    const UnrolledInstance* unrolledAt(NodeId n, const Ctx& c, uint32_t depth,
+                                       std::optional<InstanceBoxes::Key>& key);
     template <class Below, class Unrolled, class TransformBack>
     auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
                Unrolled unrolled, TransformBack transformBack);

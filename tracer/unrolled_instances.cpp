@@ -41,12 +41,12 @@ class Unroller {
           paintFrames_(!scene.paintFrames.empty()) {}
 
     void run(NodeId select, uint32_t depth, const double* frame, uint64_t path) {
-        frames_.emplace_back(frame, frame + g_.slotCount());
+        double* root = pushFrame();
+        std::copy(frame, frame + g_.slotCount(), root);
         const uint32_t rule = selectRule(g_, select, EvalState{frame, path});
         choices_.push_back(kRuleBit | rule);
         base_ = depth;
-        const PathState s{frames_[0].data(), pathRule(path, rule), depth,
-                          UnrolledInstance::kInherit};
+        const PathState s{root, pathRule(path, rule), depth, UnrolledInstance::kInherit};
         out_.root_ = build(g_.child(select, rule), s, 0, Affine::identity());
         if (out_.root_ != kNone) hierarchy(out_.root_);
         out_.nodes_.shrink_to_fit();
@@ -90,8 +90,7 @@ class Unroller {
         const NodeKind kind = g_.nodes[n].kind;
         StepScratch scratch;
         if (kind == NodeKind::Calc) {
-            frames_.emplace_back(g_.slotCount());
-            scratch.frame = frames_.back().data();
+            scratch.frame = pushFrame();
         }
         const Step st = sem_.enter(n, s, scratch);
         if (kind == NodeKind::Paint && paintFrames_ && scene_.paintFrameOf(st.state.material))
@@ -105,14 +104,15 @@ class Unroller {
             build(st.child, st.state, pendingBase, st.forward ? edge * *st.forward : edge);
         if (st.inverse) pending_.pop_back();
         if (kind == NodeKind::Select) choices_.pop_back();
-        if (kind == NodeKind::Calc) frames_.pop_back();
+        if (kind == NodeKind::Calc) --framesUsed_;
         return r;
     }
 
     uint32_t buildOperator(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
         const ::pcsg::Node& node = g_.nodes[n];
         const CsgOp op = node.op();
-        std::vector<uint32_t> kids;
+        // This operator's operands are kids_[base..] (one stack for all operators).
+        const size_t base = kids_.size();
         const size_t mark = pending_.size();
         for (uint32_t i = 0; i < node.childCount; ++i) {
             choices_.push_back(i);
@@ -120,23 +120,25 @@ class Unroller {
                 build(g_.child(n, i), Semantics::operand(s, i), mark, Affine::identity());
             choices_.pop_back();
             if (c == kNone) {
-                if (emptyOperandEmptiesAll(op, i)) return kNone;
-                continue;
+                if (!emptyOperandEmptiesAll(op, i)) continue;
+                kids_.resize(base);
+                return kNone;
             }
-            kids.push_back(c);
+            kids_.push_back(c);
         }
-        if (kids.empty()) return kNone;
-        Box inside = out_.nodes_[kids[0]].box;
-        for (size_t k = 1; k < kids.size(); ++k) {
-            const Box& b = out_.nodes_[kids[k]].box;
+        if (kids_.size() == base) return kNone;
+        Box inside = out_.nodes_[kids_[base]].box;
+        for (size_t k = base + 1; k < kids_.size(); ++k) {
+            const Box& b = out_.nodes_[kids_[k]].box;
             if (op == CsgOp::Union) inside.extend(b);
             if (op == CsgOp::Intersection) inside = intersect(inside, b);
         }
         Node x = emit(Kind::Operator, s.material, pendingBase, edge, inside);
         x.op = op;
         x.first = static_cast<uint32_t>(out_.children_.size());
-        x.count = static_cast<uint32_t>(kids.size());
-        out_.children_.insert(out_.children_.end(), kids.begin(), kids.end());
+        x.count = static_cast<uint32_t>(kids_.size() - base);
+        out_.children_.insert(out_.children_.end(), kids_.begin() + base, kids_.end());
+        kids_.resize(base);
         if (op != CsgOp::Union) setChoices(x);
         out_.nodes_.push_back(x);
         return static_cast<uint32_t>(out_.nodes_.size() - 1);
@@ -181,30 +183,34 @@ class Unroller {
     // The operands of union u and of the unions nested in it, each as a node entered from
     // u's frame: an operand below nested unions becomes a copy with their matrices in front
     // of its own, and its box mapped into u's frame.
-    void collect(uint32_t u, const std::vector<Affine>& prefix, const Affine& toU,
-                 std::vector<uint32_t>& items) {
+    // The matrices in front of u's own operands are chain_ (a stack shared by the
+    // recursion).
+    void collect(uint32_t u, const Affine& toU, std::vector<uint32_t>& items) {
         const Node un = out_.nodes_[u];
+        const size_t prefix = chain_.size();
         for (uint32_t i = 0; i < un.count; ++i) {
             const uint32_t c = out_.children_[un.first + i];
             const Node child = out_.nodes_[c];
-            std::vector<Affine> chain = prefix;
-            chain.insert(chain.end(), out_.matrices_.begin() + child.firstMatrix,
-                         out_.matrices_.begin() + child.firstMatrix + child.matrices);
-            if (isUnion(child) && chain.size() <= kMaxChain) {
+            chain_.insert(chain_.end(), out_.matrices_.begin() + child.firstMatrix,
+                          out_.matrices_.begin() + child.firstMatrix + child.matrices);
+            if (isUnion(child) && chain_.size() <= kMaxChain) {
                 Affine to = toU;
                 for (uint32_t k = 0; k < child.matrices; ++k)
                     to = to * out_.matrices_[child.firstMatrix + k].inverse();
-                collect(c, chain, to, items);
+                collect(c, to, items);
+                chain_.resize(prefix);
                 continue;
             }
-            if (prefix.empty()) {
+            if (prefix == 0) {
+                chain_.resize(prefix);
                 items.push_back(c);
                 continue;
             }
             Node copy = child;
             copy.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
-            copy.matrices = static_cast<uint32_t>(chain.size());
-            out_.matrices_.insert(out_.matrices_.end(), chain.begin(), chain.end());
+            copy.matrices = static_cast<uint32_t>(chain_.size());
+            out_.matrices_.insert(out_.matrices_.end(), chain_.begin(), chain_.end());
+            chain_.resize(prefix);
             copy.box =
                 child.box.isEmpty() ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
             copy.bvh = kNone;
@@ -217,7 +223,8 @@ class Unroller {
     void hierarchy(uint32_t n) {
         if (!isUnion(out_.nodes_[n])) return;
         std::vector<uint32_t> items;
-        collect(n, {}, Affine::identity(), items);
+        chain_.clear();
+        collect(n, Affine::identity(), items);
         for (uint32_t item : items) hierarchy(item);  // unions beyond the chain limit
         if (items.size() <= kLeafItems) return;
         out_.nodes_[n].bvh = split(items, 0, items.size());
@@ -246,12 +253,14 @@ class Unroller {
             return index;
         }
         const size_t mid = begin + (end - begin) / 2;
-        auto centre = [&](uint32_t i) {
-            const Box& box = out_.nodes_[i].box;
-            return box.isEmpty() ? 0.0 : box.center()[axis];
-        };
+        // The items' centres along the axis, computed once (indexed by node).
+        if (centres_.size() < out_.nodes_.size()) centres_.resize(out_.nodes_.size());
+        for (size_t k = begin; k < end; ++k) {
+            const Box& box = out_.nodes_[items[k]].box;
+            centres_[items[k]] = box.isEmpty() ? 0.0 : box.center()[axis];
+        }
         std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                         [&](uint32_t a, uint32_t b2) { return centre(a) < centre(b2); });
+                         [&](uint32_t a, uint32_t b2) { return centres_[a] < centres_[b2]; });
         const uint32_t left = split(items, begin, mid);
         const uint32_t right = split(items, mid, end);
         out_.bvh_[index].left = left;
@@ -273,9 +282,19 @@ class Unroller {
     const bool paintFrames_;
     uint64_t visits_ = 0;
     uint32_t base_ = 0;
-    std::vector<std::vector<double>> frames_;
+    // Parameter frames, a stack (addresses stay valid while deeper ones are pushed).
+    double* pushFrame() {
+        if (framesUsed_ == frames_.size())
+            frames_.push_back(std::make_unique<double[]>(std::max<size_t>(g_.slotCount(), 1)));
+        return frames_[framesUsed_++].get();
+    }
+    std::vector<std::unique_ptr<double[]>> frames_;
+    size_t framesUsed_ = 0;
     std::vector<Affine> pending_;
     std::vector<uint32_t> choices_;
+    std::vector<uint32_t> kids_;   // operands of the operators being built
+    std::vector<Affine> chain_;    // collect()'s matrices
+    std::vector<double> centres_;  // split()'s centres, by node
 };
 
 // ---------------------------------------------------------------------------------------
@@ -484,13 +503,29 @@ void UnrollCache::evict() {
     }
 }
 
+const UnrolledInstance* UnrollCache::built(const InstanceBoxes::Key& key, NodeId select,
+                                           uint32_t depth) {
+    if (depth >= levels_ || lru_.empty()) return nullptr;
+    Yield& y = yield_[static_cast<size_t>(scene_.graph().nodes[select].payload) * levels_ + depth];
+    if (y.off) return nullptr;
+    const auto it = index_.find(key);
+    if (it == index_.end() || !it->second->instance) return nullptr;
+    lru_.splice(lru_.begin(), lru_, it->second);
+    ++y.used;
+    return lru_.front().instance.get();
+}
+
 const UnrolledInstance* UnrollCache::get(NodeId select, uint32_t depth, const double* frame,
                                          uint64_t path) {
+    return get(scene_.instanceBoxes()->keyOf(select, frame, path), select, depth, frame, path);
+}
+
+const UnrolledInstance* UnrollCache::get(const InstanceBoxes::Key& key, NodeId select,
+                                         uint32_t depth, const double* frame, uint64_t path) {
     if (depth >= levels_) return nullptr;
     Yield& y = yield_[static_cast<size_t>(scene_.graph().nodes[select].payload) * levels_ + depth];
     if (y.off) return nullptr;
     const InstanceBoxes* boxes = scene_.instanceBoxes();
-    const InstanceBoxes::Key key = boxes->keyOf(select, frame, path);
     constexpr size_t kNoteBytes = sizeof(Entry) + 64;
     const auto it = index_.find(key);
     if (it == index_.end()) {

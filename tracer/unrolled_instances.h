@@ -139,6 +139,13 @@ class UnrollCache {
     // nullptr (not worth expanding yet, or too large). Throws RuntimeError (without this
     // S-node in its module path) when unrolling meets a run-time error.
     const UnrolledInstance* get(NodeId select, uint32_t depth, const double* frame, uint64_t path);
+    // The same, with the instance's key (InstanceBoxes::keyOf) computed by the caller.
+    const UnrolledInstance* get(const InstanceBoxes::Key& key, NodeId select, uint32_t depth,
+                                const double* frame, uint64_t path);
+
+    // The instance if it is expanded already (counted as a use), else nullptr: no note,
+    // no expansion.
+    const UnrolledInstance* built(const InstanceBoxes::Key& key, NodeId select, uint32_t depth);
 
     UnrolledInstance::Scratch& scratch() { return scratch_; }
     uint64_t expansions() const { return expansions_; }

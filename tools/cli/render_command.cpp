@@ -35,6 +35,7 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -212,6 +213,37 @@ struct FrameContext {
     double base = 0, share = 1;
 };
 
+// The count (primitive equivalence, and the scene's run-time errors on every path) runs on
+// a thread of its own beside the render, whose first tiles need not wait for it: a long
+// count (a terrain's 2 million triangles, which do not repeat and cannot be memoised) then
+// shares the cores with the render instead of leaving all but one idle. What is reported
+// stays the serial order's: an error of the count wins over the render's (the render is
+// cancelled and its pixels dropped), then the render's own error; nothing is written
+// unless both succeed.
+void countBesideRender(const Graph& g, const CountOptions& co, tracer::RenderOptions ro,
+                       RenderReport& report) {
+    std::atomic<bool> cancel{false};
+    if (ro.cancel) throw std::logic_error("countBesideRender: the render has its own cancel flag");
+    ro.cancel = &cancel;
+    std::exception_ptr countError, renderError;
+    std::thread counter([&] {
+        try {
+            report.count = countExpansion(g, co);
+        } catch (...) {
+            countError = std::current_exception();
+            cancel = true;
+        }
+    });
+    try {
+        report.result = tracer::render(g, ro);
+    } catch (...) {
+        renderError = std::current_exception();
+    }
+    counter.join();
+    if (countError) std::rethrow_exception(countError);
+    if (renderError) std::rethrow_exception(renderError);
+}
+
 int countAndRender(Graph& g, const RenderCommandOptions& o, RenderReport& report,
                    const FrameContext& frame = {}) {
     // Primitive equivalence: what the expanded tree would hold, counted without building
@@ -239,8 +271,7 @@ int countAndRender(Graph& g, const RenderCommandOptions& o, RenderReport& report
     try {
         CountOptions co;
         co.maxVisits = o.countVisits;
-        report.count = countExpansion(g, co);
-        report.result = tracer::render(g, ro);
+        countBesideRender(g, co, ro, report);
     } catch (const RuntimeError& e) {
         if (showProgress) bar->finish();
         std::cerr << e.format(g) << frameNote << "\n";

@@ -221,6 +221,35 @@ TEST(RenderCommand, ARunTimeErrorExitsOneAndWritesNothing) {
     }
 }
 
+// Two errors: A's comes first in the count's walk (behind the camera); B's is in view.
+const char* kTwoRunTimeErrors =
+    "camera { location <0, -6, 0>  look_at <0, 0, 0>  sky <0, 0, 1>  angle 40 }\n"
+    "{c=2} (move(0, -40, 0) A \u222a B)\n"
+    "A if(c > 0, 3, 1)\n"
+    "1: A -> sphere\n"
+    "2: A -> {c=c-1} uscale(0.5) A\n"
+    "B if(c > 0, 4, 1)\n"
+    "1: B -> sphere\n"
+    "2: B -> {c=c-1} uscale(0.5) B\n";
+
+TEST(RenderCommand, TheCountsErrorWinsOverTheRendersAsWhenTheyRanInTurn) {
+    // The count runs beside the render; what is reported is still the count's first error
+    // (A's), as when the count ran first, whatever the threads.
+    for (const char* threads : {"1", "2"}) {
+        SCOPED_TRACE(std::string("--threads ") + threads);
+        TempDir dir;
+        const std::string scene = dir.write("two.pcsg", kTwoRunTimeErrors);
+        const std::string out = dir.file("two.png");
+        const ChildResult r = pcsg(
+            {"render", scene, "-o", out, "--width", "32", "--height", "24", "--threads", threads});
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_EQ(occurrences(r.err, "error"), 1u) << r.err;
+        EXPECT_EQ(r.err.rfind(scene + ":3:3: error: the selection function of module A", 0), 0u)
+            << r.err;
+        EXPECT_FALSE(std::filesystem::exists(out));
+    }
+}
+
 TEST(RenderCommand, ARunTimeErrorStartsNoWriter) {
     // This writer would complain; for an EXR that fails at run time it never runs.
     Subreaper subreaper;
