@@ -152,6 +152,13 @@ InstanceBoxOptions always() {
     return o;
 }
 
+// As always(), but nothing is ever stored: every box is computed on its own.
+InstanceBoxOptions storingNothing() {
+    InstanceBoxOptions o = always();
+    o.maxBytes = 0;
+    return o;
+}
+
 TEST(InstanceBoxes, EveryPrimitiveLiesInsideTheBoxOfEachInstanceAboveIt) {
     for (const char* text : {testing::kSierpinski, kTree, kTerrain, kCsgPlant}) {
         auto c = compile(text);
@@ -169,9 +176,7 @@ TEST(InstanceBoxes, TheBoxDoesNotDependOnWhatTheCacheHeld) {
         ASSERT_TRUE(c->graph);
         const Graph& g = *c->graph;
         const Bounds bounds = computeBounds(g);
-        InstanceBoxOptions none = always();
-        none.maxBytes = 0;  // nothing is ever stored
-        const InstanceBoxes cold(g, bounds, none), warm(g, bounds, always());
+        const InstanceBoxes cold(g, bounds, storingNothing()), warm(g, bounds, always());
         auto coldWorker = cold.makeWorker(), warmWorker = warm.makeWorker();
         // The axiom's S-node instance, after its inner instances are in the warm cache.
         std::vector<double> frame(g.slotCount());
@@ -231,9 +236,7 @@ TEST(InstanceBoxes, FillingAheadStoresTheBoxesTheMissesWouldCompute) {
         ASSERT_TRUE(c->graph);
         const Graph& g = *c->graph;
         const Bounds bounds = computeBounds(g);
-        InstanceBoxOptions none = always();
-        none.maxBytes = 0;  // nothing is ever stored: every box computed on its own
-        const InstanceBoxes cold(g, bounds, none), filled(g, bounds, always());
+        const InstanceBoxes cold(g, bounds, storingNothing()), filled(g, bounds, always());
         filled.prefill(g.axiom);
         if (text == kTerrain) {  // (the tree's instances of a depth are all alike: one each)
             const InstanceBoxStats ahead = filled.stats();
