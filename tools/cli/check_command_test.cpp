@@ -134,6 +134,13 @@ TEST(CheckCommand, UsageErrorsExitTwo) {
     EXPECT_NE(help.out.find("--stats"), std::string::npos);
 }
 
+TEST(CheckCommand, PcsgPrintsItsVersion) {
+    // `pcsg --version` needs no subcommand, and names the project's version from CMake.
+    const ChildResult r = pcsg({"--version"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.out, std::string("pcsg ") + PCSG_VERSION + "\n");
+}
+
 TEST(CheckCommand, TheDefaultSceneCompiles) {
     const std::string scene = std::string(PCSG_SCENES_DIR) + "/sierpinski.pcsg";
     const ChildResult r = pcsg({"check", "--json", scene});

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
         "compiled into a small cyclic CSG graph, which is ray traced directly or unrolled\n"
         "into POV-Ray 3.7 scene text.",
         "pcsg"};
+    app.set_version_flag("--version", "pcsg " PCSG_VERSION);
     app.require_subcommand(1);
     int status = 0;
     pcsg::tools::addCheckCommand(app, status);
