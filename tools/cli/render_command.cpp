@@ -449,6 +449,9 @@ nlohmann::json frameJson(const FrameFigures& f) {
                         {"bounds_seconds", f.result.boundsSeconds},
                         {"bounds", f.ownBounds ? "frame" : "range"},
                         {"node_visits", f.result.nodeVisits},
+                        // unrolled in this frame (not found in the table, nor in the
+                        // sequence's, which keeps the boxes that do not change with the time)
+                        {"instance_boxes_computed", f.result.instanceBoxes.computed},
                         {"image_write_seconds", f.imageWriteSeconds}};
     if (f.primitives) j["primitive_equivalence"] = *f.primitives;
     return j;
