@@ -840,7 +840,9 @@ void addRenderCommand(CLI::App& app, int& status) {
                   "sub-graph instances (for comparison; the image is the same)");
     cmd->add_option("--box-cache-mb", o->boxCacheMb,
                     "Memory limit of the instance-box cache in MB (the exact boxes of sub-graph "
-                    "instances, filled lazily while rendering)")
+                    "instances, filled lazily while rendering; with --frames, the boxes that do "
+                    "not change with the time are kept for the whole sequence in a second "
+                    "table with the same limit)")
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--expansion-cache-mb", o->expansionCacheMb,
