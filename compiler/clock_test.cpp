@@ -6,6 +6,7 @@
 
 #include "compile_test_util.h"
 #include "eval.h"
+#include "walk.h"
 
 namespace pcsg {
 namespace {
@@ -131,6 +132,31 @@ TEST(Clock, RandomChoicesDoNotDependOnTheClock) {
     const double v0 = evalExpr(h, e, EvalState{nullptr, kRootPath});
     h.time = Time{0.7, 8};
     EXPECT_EQ(evalExpr(h, e, EvalState{nullptr, kRootPath}), v0);
+}
+
+// Which modules' instances change with the time (walk.h's ModuleDependencies::usesTime):
+// a module whose own rules read neither `clock` nor `frame` but that reaches one that does
+// changes too; a module that reaches none does not, whatever reads the time above it.
+TEST(Clock, ModuleDependenciesKnowWhichSubGraphsReadTheTime) {
+    auto c = compile(
+        "move(clock, 0, 0) A ∪ B ∪ C\n"
+        "A 1\n1: A -> uscale(2) D\n"
+        "B 1\n1: B -> sphere\n"
+        "C if(frame > 2, 1, 2)\n1: C -> cube\n2: C -> sphere\n"
+        "D 1\n1: D -> {r = 1 + clock} torus(r, 0.1)\n");
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    const std::vector<ModuleDependencies> deps = moduleDependencies(g);
+    auto usesTime = [&](const std::string& name) {
+        for (size_t m = 0; m < g.modules.size(); ++m)
+            if (g.modules[m].name == name) return deps[m].analysed && deps[m].usesTime;
+        ADD_FAILURE() << "no module " << name;
+        return false;
+    };
+    EXPECT_TRUE(usesTime("A"));  // through D
+    EXPECT_FALSE(usesTime("B"));
+    EXPECT_TRUE(usesTime("C"));  // its selection reads frame
+    EXPECT_TRUE(usesTime("D"));
 }
 
 }  // namespace

@@ -7,46 +7,50 @@ namespace pcsg {
 
 namespace {
 
-void exprInfo(const Graph& g, ExprId id, bool& usesPath, std::vector<uint8_t>& readSet) {
+void exprInfo(const Graph& g, ExprId id, bool& usesPath, bool& usesTime,
+              std::vector<uint8_t>& readSet) {
     if (id == kNone || id >= g.exprs.size()) return;
     const Expr& e = g.exprs[id];
     if (e.usesPath) usesPath = true;
+    if (e.usesTime) usesTime = true;
     for (uint32_t pc = e.begin; pc < e.end; ++pc) {
         const Instr& in = g.code[pc];
         if (in.op == Op::Load && in.a < readSet.size()) readSet[in.a] = 1;
         // Belt and braces: an expression that says it does not use the path but calls
         // rand() or choose() still does.
         if (in.op == Op::Rand0 || in.op == Op::Choose) usesPath = true;
+        if (in.op == Op::Clock || in.op == Op::Frame) usesTime = true;
     }
 }
 
-void nodeInfo(const Graph& g, NodeId n, bool& usesPath, std::vector<uint8_t>& readSet) {
+void nodeInfo(const Graph& g, NodeId n, bool& usesPath, bool& usesTime,
+              std::vector<uint8_t>& readSet) {
     const Node& node = g.nodes[n];
     switch (node.kind) {
         case NodeKind::Select: {
             const Module& m = g.modules[node.payload];
-            exprInfo(g, m.select, usesPath, readSet);
-            for (ExprId c : m.conditions) exprInfo(g, c, usesPath, readSet);
+            exprInfo(g, m.select, usesPath, usesTime, readSet);
+            for (ExprId c : m.conditions) exprInfo(g, c, usesPath, usesTime, readSet);
             break;
         }
         case NodeKind::Calc: {
             const Calc& c = g.calcs[node.payload];
             for (uint32_t i = 0; i < c.count; ++i)
-                exprInfo(g, g.assignments[c.first + i].value, usesPath, readSet);
+                exprInfo(g, g.assignments[c.first + i].value, usesPath, usesTime, readSet);
             break;
         }
         case NodeKind::Transform: {
             const Transform& t = g.transforms[node.payload];
             if (!t.constant)
                 for (uint32_t i = 0; i < t.argCount; ++i)
-                    exprInfo(g, g.args[t.firstArg + i], usesPath, readSet);
+                    exprInfo(g, g.args[t.firstArg + i], usesPath, usesTime, readSet);
             break;
         }
         case NodeKind::Primitive: {
             const Primitive& p = g.primitives[node.payload];
             if (!p.constant)
                 for (uint32_t i = 0; i < p.argCount; ++i)
-                    exprInfo(g, g.args[p.firstArg + i], usesPath, readSet);
+                    exprInfo(g, g.args[p.firstArg + i], usesPath, usesTime, readSet);
             break;
         }
         default:
@@ -71,13 +75,13 @@ std::vector<ModuleDependencies> moduleDependencies(const Graph& g) {
         const NodeId start = g.modules[m].node;
         if (start == kNone || start >= g.nodes.size()) continue;
         std::fill(readSet.begin(), readSet.end(), 0);
-        bool usesPath = false;
+        bool usesPath = false, usesTime = false;
         todo.assign(1, start);
         seen[start] = m;
         while (!todo.empty()) {
             const NodeId n = todo.back();
             todo.pop_back();
-            nodeInfo(g, n, usesPath, readSet);
+            nodeInfo(g, n, usesPath, usesTime, readSet);
             const Node& node = g.nodes[n];
             for (uint32_t i = 0; i < node.childCount; ++i) {
                 const NodeId c = g.child(n, i);
@@ -89,6 +93,7 @@ std::vector<ModuleDependencies> moduleDependencies(const Graph& g) {
         }
         info[m].analysed = true;
         info[m].usesPath = usesPath;
+        info[m].usesTime = usesTime;
         for (Slot s = 0; s < readSet.size(); ++s)
             if (readSet[s]) info[m].reads.push_back(s);
     }

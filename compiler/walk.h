@@ -251,6 +251,9 @@ class Walker {
 struct ModuleDependencies {
     bool analysed = false;  // false: the graph was too large to analyse (memoise nothing)
     bool usesPath = false;
+    // Reads `clock` or `frame` (Graph::time): its instances differ from frame to frame of a
+    // sequence even with the same values in `reads`.
+    bool usesTime = false;
     std::vector<Slot> reads;  // ascending
 };
 

@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "primitives.h"
 
@@ -177,7 +178,7 @@ class BoxSink {
     bool lookup(NodeId n, uint32_t, const double* frame, uint64_t path, Result& out) {
         InstanceBoxes::Stored s;
         const InstanceBoxes::Key k = boxes_.keyOf(n, frame, path);
-        if (boxes_.find(k, s)) {
+        if (boxes_.find(n, k, s)) {
             out = {s.box, s.weight};
             visits_ += s.weight;  // it stands for that many visits
             return true;
@@ -185,14 +186,14 @@ class BoxSink {
         starts_.push_back({visits_, k});
         return false;
     }
-    void store(NodeId, uint32_t, const double*, uint64_t, Result& r) {
+    void store(NodeId n, uint32_t, const double*, uint64_t, Result& r) {
         // Every visit below this S-node, including the ones its stored parts stand for.
         r.weight = visits_ - starts_.back().visits;
         const InstanceBoxes::Key k = starts_.back().key;
         starts_.pop_back();
         r.box = storable(r.box);
         if (r.weight >= boxes_.opt_.minWeight)
-            boxes_.insert(k, InstanceBoxes::Stored{r.box, r.weight});
+            boxes_.insert(n, k, InstanceBoxes::Stored{r.box, r.weight});
     }
 
     Result toParent(const Affine& m, const Result& local) const {
@@ -240,7 +241,13 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
       opt_(options),
       deps_(moduleDependencies(g)),
       table_(std::make_unique<Table>(options.maxBytes)),
+      sequence_(options.sequence),
+      lasting_(g.modules.size(), 0),
       levels_(g.scene.settings.maxDepth + 2) {
+    if (sequence_ && &sequence_->g_ != &g)
+        throw std::logic_error("InstanceBoxes: the sequence's boxes belong to another graph");
+    for (size_t m = 0; m < lasting_.size() && sequence_; ++m)
+        lasting_[m] = deps_[m].analysed && !deps_[m].usesTime;
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);
     decision_ = std::make_unique<std::atomic<uint8_t>[]>(n);
     expand_ = std::make_unique<std::atomic<uint8_t>[]>(n);
@@ -302,11 +309,14 @@ InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint
     return {a | 1, b};  // a != 0: never the empty slot
 }
 
-bool InstanceBoxes::find(const Key& k, Stored& out) const {
-    return table_->find(k, out);
+InstanceBoxes::Table& InstanceBoxes::tableOf(NodeId select) const {
+    return lasting_[g_.nodes[select].payload] ? *sequence_->table_ : *table_;
 }
-void InstanceBoxes::insert(const Key& k, const Stored& s) const {
-    table_->insert(k, s);
+bool InstanceBoxes::find(NodeId select, const Key& k, Stored& out) const {
+    return tableOf(select).find(k, out);
+}
+void InstanceBoxes::insert(NodeId select, const Key& k, const Stored& s) const {
+    tableOf(select).insert(k, s);
 }
 
 // The trial of exact boxes at (module, depth): do they pay?
@@ -342,7 +352,7 @@ void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const
 Box InstanceBoxes::box(Worker& w, const Key& k, NodeId select, uint32_t depth, const double* frame,
                        uint64_t path) const {
     Stored s;
-    if (!table_->find(k, s)) s = unroll(w, select, depth, frame, path);
+    if (!find(select, k, s)) s = unroll(w, select, depth, frame, path);
     record(select, depth, s);
     return paddedBox(s.box);
 }
@@ -456,7 +466,7 @@ void InstanceBoxes::prefill(NodeId start, const std::atomic<bool>* cancel) const
                     return;
                 const Seed& sd = seeds[i];
                 Stored s;
-                if (table_->find(keyOf(sd.node, sd.frame.data(), sd.path), s)) continue;
+                if (find(sd.node, keyOf(sd.node, sd.frame.data(), sd.path), s)) continue;
                 try {
                     unroll(w, sd.node, sd.depth, sd.frame.data(), sd.path);
                 } catch (const RuntimeError&) {
@@ -467,13 +477,31 @@ void InstanceBoxes::prefill(NodeId start, const std::atomic<bool>* cancel) const
         tbb::simple_partitioner());
 }
 
+// With a sequence's table: its entries too (what this frame could find).
 InstanceBoxStats InstanceBoxes::stats() const {
     InstanceBoxStats st;
     st.entries = table_->entries();
     st.bytes = table_->bytes();
     st.computed = computed_.load(std::memory_order_relaxed);
     st.full = table_->full();
+    if (sequence_) {
+        st.entries += sequence_->table_->entries();
+        st.bytes += sequence_->table_->bytes();
+        st.full = st.full || sequence_->table_->full();
+    }
     return st;
+}
+
+SequenceInstanceBoxes::SequenceInstanceBoxes(const Graph& g, size_t maxBytes)
+    : g_(g), table_(std::make_unique<InstanceBoxes::Table>(maxBytes)) {}
+
+SequenceInstanceBoxes::~SequenceInstanceBoxes() = default;
+
+uint64_t SequenceInstanceBoxes::entries() const {
+    return table_->entries();
+}
+uint64_t SequenceInstanceBoxes::bytes() const {
+    return table_->bytes();
 }
 
 }  // namespace pcsg::tracer

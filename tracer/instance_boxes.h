@@ -49,6 +49,8 @@
 
 namespace pcsg::tracer {
 
+class SequenceInstanceBoxes;
+
 struct InstanceBoxOptions {
     size_t maxBytes = 64u << 20;  // the table's size limit
     uint64_t minWeight = 48;      // store instances whose unrolling took this many visits
@@ -62,6 +64,9 @@ struct InstanceBoxOptions {
     // expanding (unrolled_instances.h).
     uint64_t minExpandWeight = 12;
     uint64_t maxUnrollWeight = 8192;
+    // The frames of a sequence share the boxes that do not change with the time (see
+    // SequenceInstanceBoxes); null: every box in this cache's own table.
+    std::shared_ptr<SequenceInstanceBoxes> sequence;
 };
 
 struct InstanceBoxStats {
@@ -125,6 +130,7 @@ class InstanceBoxes {
   private:
     friend class BoxSink;
     friend class SeedSink;
+    friend class SequenceInstanceBoxes;
     struct Seed;
     std::vector<Seed> seedsAt(NodeId start, uint32_t depth, uint64_t maxVisits) const;
     struct Stored {
@@ -135,8 +141,11 @@ class InstanceBoxes {
 
     Stored unroll(Worker& w, NodeId select, uint32_t depth, const double* frame,
                   uint64_t path) const;
-    bool find(const Key& k, Stored& out) const;
-    void insert(const Key& k, const Stored& s) const;
+    // The table that holds the instances of this S-node's module: the sequence's when its
+    // sub-graph reads no time, else this cache's own.
+    Table& tableOf(NodeId select) const;
+    bool find(NodeId select, const Key& k, Stored& out) const;
+    void insert(NodeId select, const Key& k, const Stored& s) const;
     void record(NodeId select, uint32_t depth, const Stored& s) const;
 
     const Graph& g_;
@@ -145,6 +154,8 @@ class InstanceBoxes {
     InstanceBoxOptions opt_;
     std::vector<ModuleDependencies> deps_;
     std::unique_ptr<Table> table_;
+    std::shared_ptr<SequenceInstanceBoxes> sequence_;
+    std::vector<uint8_t> lasting_;  // per module: its boxes go to the sequence's table
     mutable std::atomic<uint64_t> computed_{0};
 
     // Per (module, depth < levels_): 0 undecided, 1 use exact boxes, 2 static only;
@@ -153,6 +164,30 @@ class InstanceBoxes {
     mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_, expand_;
     mutable std::unique_ptr<std::atomic<uint32_t>[]> tried_, paid_;
     mutable std::unique_ptr<std::atomic<uint64_t>[]> minWeight_, maxWeight_;
+};
+
+// The boxes a sequence's frames share (tools/cli/render_command.cpp's runFrames): an
+// instance of a module whose sub-graph reads neither `clock` nor `frame`
+// (ModuleDependencies::usesTime) unrolls to the same primitives in every frame, so its box
+// and weight are the same numbers in every frame, and its key (which holds no time) is
+// exact across them. The frames' InstanceBoxes store such instances here and find what
+// earlier frames computed; instances of modules that read the time stay in each frame's
+// own table. For one graph (only its time changes between frames); thread-safe; at most
+// maxBytes, beside each frame's own table.
+class SequenceInstanceBoxes {
+  public:
+    SequenceInstanceBoxes(const Graph& g, size_t maxBytes);
+    ~SequenceInstanceBoxes();
+    SequenceInstanceBoxes(const SequenceInstanceBoxes&) = delete;
+    SequenceInstanceBoxes& operator=(const SequenceInstanceBoxes&) = delete;
+
+    uint64_t entries() const;
+    uint64_t bytes() const;
+
+  private:
+    friend class InstanceBoxes;
+    const Graph& g_;
+    std::unique_ptr<InstanceBoxes::Table> table_;
 };
 
 }  // namespace pcsg::tracer

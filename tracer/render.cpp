@@ -333,6 +333,7 @@ Bounds boundsFor(const Graph& g, const RenderOptions& opt, RenderResult& figures
 InstanceBoxOptions boxOptionsFor(const RenderOptions& opt) {
     InstanceBoxOptions boxOptions;
     boxOptions.maxBytes = opt.instanceBoxBytes;
+    boxOptions.sequence = opt.sequenceBoxes;
     return boxOptions;
 }
 

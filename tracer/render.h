@@ -56,6 +56,9 @@ struct RenderOptions {
     // kept in a table of at most this many bytes.
     bool instanceBoxes = true;
     size_t instanceBoxBytes = 64u << 20;
+    // A sequence's boxes that do not change with the time, kept from frame to frame
+    // (SequenceInstanceBoxes, for this graph); null: this render's own table alone.
+    std::shared_ptr<SequenceInstanceBoxes> sequenceBoxes;
     // Expanded instances (unrolled_instances.h), each thread's cache holding at most this
     // many bytes; 0: none.
     size_t expansionBytesPerThread = 16u << 20;

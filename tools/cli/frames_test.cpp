@@ -106,6 +106,58 @@ TEST(Frames, AFrameAloneIsTheFrameInTheSequence) {
     EXPECT_EQ(j["frames"][6]["clock"].get<double>(), 0.9);
 }
 
+// The frames share the exact boxes of the instances that do not change with the time
+// (tracer::SequenceInstanceBoxes): F's sub-graph reads no time (only the transform above it
+// moves), G's spheres grow with the clock although the parameters G reads are the same in
+// every frame. Each frame is still the frame rendered alone, and the later frames unroll
+// fewer instances than the first.
+const char* kSharing =
+    "camera { location <0, -9, 2>  look_at <0, 0, 0>  angle 60 }\n"
+    "move(clock * 2 - 1, 0, 1) {n = 5; s = 1} F ∪ move(0, 0, -1.5) {k = 3} G\n"
+    "F if(n > 0, 2, 1)\n"
+    "1: F -> uscale(s) sphere\n"
+    "2: F -> {n = n-1} (move(0.6,0,0.3) {s = s*0.4} F ∪ move(-0.4,0,-0.2) {s = s*0.9} F)\n"
+    "G if(k > 0, 2, 1)\n"
+    "1: G -> uscale(0.2 + clock) sphere\n"
+    "2: G -> {k = k-1} (move(1.2,0,0) uscale(0.6) G ∪ move(-1.2,0,0) uscale(0.6) G)\n";
+
+TEST(Frames, AFrameAloneIsTheFrameInASequenceThatKeptItsBoxes) {
+    TempDir dir;
+    const std::string scene = dir.write("k.pcsg", kSharing);
+    auto sequence = [&](const char* threads) {
+        std::vector<std::string> args = {
+            "render",   scene, "-o",        dir.file(std::string(threads) + ".png"),
+            "--frames", "4",   "--width",   "40",
+            "--height", "30",  "--threads", threads,
+            "--json"};
+        const ChildResult r = pcsg(args);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return r.exitCode == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+    };
+    const nlohmann::json two = sequence("2"), one = sequence("1");
+    ASSERT_EQ(two["frames"].size(), 4u);
+    ASSERT_EQ(one["frames"].size(), 4u);
+    for (size_t k = 0; k < 4; ++k) {
+        const nlohmann::json& f = two["frames"][k];
+        const std::string clock = nlohmann::json(f["clock"].get<double>()).dump();
+        const std::string alone = dir.file("alone.png");
+        const ChildResult a = pcsg({"render", scene, "-o", alone, "--clock", clock, "--width", "40",
+                                    "--height", "30", "--threads", "1", "--json"});
+        ASSERT_EQ(a.exitCode, 0) << a.err;
+        EXPECT_EQ(readFile(alone), readFile(f["output"].get<std::string>()))
+            << "frame " << f["frame"] << " at clock " << clock;
+        EXPECT_EQ(readFile(alone), readFile(one["frames"][k]["output"].get<std::string>()));
+        // On one thread the counts are exact: after the first frame, F's boxes are found.
+        const uint64_t computed = nlohmann::json::parse(a.out)["instance_boxes"]["computed"];
+        const uint64_t inSequence = one["frames"][k]["instance_boxes_computed"];
+        if (k == 0) {
+            EXPECT_EQ(inSequence, computed);
+        } else {
+            EXPECT_LT(inSequence, computed) << "frame " << k + 1;
+        }
+    }
+}
+
 // The sequence's boxes hold for its whole clock range; a frame may compute tighter ones
 // of its own. Either way the pixels are the same, and --json says which a frame used.
 TEST(Frames, RangeBoxesAndFrameBoxesGiveTheSamePixels) {

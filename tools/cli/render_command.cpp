@@ -209,6 +209,7 @@ int distributedStill(Graph& g, const RenderCommandOptions& o, const tracer::Rend
 struct FrameContext {
     std::string note;
     std::shared_ptr<const tracer::Bounds> bounds;
+    std::shared_ptr<tracer::SequenceInstanceBoxes> instanceBoxes;
     std::shared_ptr<ProgressBar> bar;
     double base = 0, share = 1;
 };
@@ -251,6 +252,7 @@ int countAndRender(Graph& g, const RenderCommandOptions& o, RenderReport& report
     // scene's run-time errors on paths no ray visits.
     tracer::RenderOptions ro = tracerOptions(o);
     ro.bounds = frame.bounds;
+    ro.sequenceBoxes = frame.instanceBoxes;
     const std::string& frameNote = frame.note;
     auto bar = frame.bar ? frame.bar : std::make_shared<ProgressBar>();
     const bool showProgress = isatty(STDERR_FILENO) != 0;
@@ -360,11 +362,14 @@ struct FrameFigures {
 // The hyper-bounding boxes of a sequence (docs/language.md section 11): computed once
 // for the clock range of the frames rendered, with `clock` and `frame` intervals. A frame
 // computes its own, tighter boxes too (they cull more) when FrameBoundsChoice (frames.h)
-// says so. The image is the same either way.
+// says so. The image is the same either way. And the exact boxes of the instances that
+// do not change with the time (tracer::SequenceInstanceBoxes), kept from frame to frame.
 class SequenceBounds {
   public:
-    SequenceBounds(const Graph& g, const FramePlan& plan, const std::string& mode)
-        : choice_(frameBoundsMode(mode).value_or(FrameBoundsChoice::Mode::Auto)) {
+    SequenceBounds(const Graph& g, const FramePlan& plan, const RenderCommandOptions& o)
+        : choice_(frameBoundsMode(o.frameBounds).value_or(FrameBoundsChoice::Mode::Auto)) {
+        if (!o.noInstanceBoxes)
+            instances_ = std::make_shared<tracer::SequenceInstanceBoxes>(g, o.boxCacheMb << 20);
         const double a = frameClock(plan, plan.first), b = frameClock(plan, plan.last);
         tracer::BoundsOptions bo;
         bo.time = TimeRange{std::min(a, b), std::max(a, b), plan.first, plan.last};
@@ -386,10 +391,14 @@ class SequenceBounds {
         choice_.frameDone(ownBounds, r.boundsSeconds, r.seconds);
     }
     double seconds() const { return seconds_; }
+    const std::shared_ptr<tracer::SequenceInstanceBoxes>& instanceBoxes() const {
+        return instances_;
+    }
 
   private:
     FrameBoundsChoice choice_;
     std::shared_ptr<const tracer::Bounds> range_;
+    std::shared_ptr<tracer::SequenceInstanceBoxes> instances_;
     double seconds_ = 0;
 };
 
@@ -411,8 +420,9 @@ int renderFrame(const RenderCommandOptions& o, const FramePlan& plan, int f, Gra
     fo.output = frameFileName(o.output, f, plan.frames);
     RenderReport report;
     const int count = plan.last - plan.first + 1;
-    const FrameContext context{note, bounds.next(), bar, double(f - plan.first) / count,
-                               1.0 / count};
+    const FrameContext context{
+        note,       bounds.next(), bounds.instanceBoxes(), bar, double(f - plan.first) / count,
+        1.0 / count};
     if (const int status = countAndRender(g, fo, report, context)) return status;
     out.ownBounds = context.bounds == nullptr;
     bounds.update(report.result, out.ownBounds);
@@ -439,6 +449,9 @@ nlohmann::json frameJson(const FrameFigures& f) {
                         {"bounds_seconds", f.result.boundsSeconds},
                         {"bounds", f.ownBounds ? "frame" : "range"},
                         {"node_visits", f.result.nodeVisits},
+                        // unrolled in this frame (not found in the table, nor in the
+                        // sequence's, which keeps the boxes that do not change with the time)
+                        {"instance_boxes_computed", f.result.instanceBoxes.computed},
                         {"image_write_seconds", f.imageWriteSeconds}};
     if (f.primitives) j["primitive_equivalence"] = *f.primitives;
     return j;
@@ -557,7 +570,7 @@ int runFrames(const RenderCommandOptions& o, const FramePlan& plan, CompiledScen
     Graph& g = *compiled.graph;
     std::vector<FrameFigures> done;
     useOneMallocArena();
-    SequenceBounds bounds(g, plan, o.frameBounds);
+    SequenceBounds bounds(g, plan, o);
     // One bar over the whole sequence, cleared while a frame's line is printed.
     auto bar = std::make_shared<ProgressBar>();
     const bool showProgress = isatty(STDERR_FILENO) != 0;
@@ -827,7 +840,9 @@ void addRenderCommand(CLI::App& app, int& status) {
                   "sub-graph instances (for comparison; the image is the same)");
     cmd->add_option("--box-cache-mb", o->boxCacheMb,
                     "Memory limit of the instance-box cache in MB (the exact boxes of sub-graph "
-                    "instances, filled lazily while rendering)")
+                    "instances, filled lazily while rendering; with --frames, the boxes that do "
+                    "not change with the time are kept for the whole sequence in a second "
+                    "table with the same limit)")
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--expansion-cache-mb", o->expansionCacheMb,
