@@ -214,7 +214,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     paintMaps_.clear();
     inverses_.clear();
     if (g_.axiom == kNone) return false;
-    const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid
+    const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
     if (scene_.useBounds) {

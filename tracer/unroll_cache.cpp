@@ -76,6 +76,7 @@ void UnrollCache::evict() {
             Shard& s = shardOf(k);
             tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
             const auto it = s.map.find(k);
+            if (it == s.map.end()) continue;  // (never: a key is queued while it is stored)
             Entry& e = it->second;
             if (e.state == Entry::State::Building ||
                 e.referenced.exchange(false, std::memory_order_relaxed)) {
@@ -120,6 +121,7 @@ const UnrolledInstance* UnrollCache::Reader::built(const InstanceBoxes::Key& key
     const size_t y = cache_.yieldIndex(select, depth);
     if (cache_.yield_[y].off.load(std::memory_order_relaxed)) return nullptr;
     Shard& s = cache_.shardOf(key);
+    pinOnce();
     tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
     const auto it = s.map.find(key);
     if (it == s.map.end() || it->second.state != Entry::State::Built) return nullptr;
@@ -145,6 +147,7 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
     Yield& yield = cache_.yield_[y];
     if (yield.off.load(std::memory_order_relaxed)) return nullptr;
     Shard& s = cache_.shardOf(key);
+    pinOnce();
     Entry* e = nullptr;
     bool inserted = false;
     {

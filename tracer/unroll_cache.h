@@ -6,7 +6,7 @@
 //    lock of one shard of 64); each thread uses the cache through a Reader of its own.
 //  - Lifetime: instances are immutable once built. An instance evicted while another
 //    thread traces it is freed only when that thread has unpinned (deferred_free.h): a
-//    tracer pins its Reader for each ray.
+//    tracer's Reader is pinned from its first look-up in a ray to the ray's end.
 //  - Notes: the first meeting of an instance, by any thread, leaves a note; the second,
 //    by any thread, expands it. While one thread expands an instance it is marked "in
 //    construction", and the others walk the graph below it meanwhile, not wait.
@@ -82,8 +82,8 @@ class UnrollCache::Reader {
 
     // The expanded instance of the S-node instance (select, frame, path) at `depth`, or
     // nullptr (not worth expanding yet, being expanded by another thread, or too large).
-    // Valid while this reader stays pinned. Throws RuntimeError (without this S-node in
-    // its module path) when unrolling meets a run-time error.
+    // Valid until the end of the Pin scope it was asked in. Throws RuntimeError (without
+    // this S-node in its module path) when unrolling meets a run-time error.
     const UnrolledInstance* get(const InstanceBoxes::Key& key, NodeId select, uint32_t depth,
                                 const double* frame, uint64_t path);
     const UnrolledInstance* get(NodeId select, uint32_t depth, const double* frame, uint64_t path);
@@ -97,26 +97,36 @@ class UnrollCache::Reader {
 
   private:
     friend class Pin;
+    void pinOnce() {  // (before the first look-up in a Pin scope)
+        if (pinned_) return;
+        cache_.retired_.pin(*slot_);
+        pinned_ = true;
+    }
     const UnrolledInstance* expand(Shard& s, Entry& e, size_t y, NodeId select, uint32_t depth,
                                    const double* frame, uint64_t path);
     void used(size_t y);
 
     UnrollCache& cache_;
     DeferredFree::Slot* slot_;
-    uint32_t pins_ = 0;
+    uint32_t scopes_ = 0;  // nested Pin scopes
+    bool pinned_ = false;
     std::vector<uint32_t> uses_;  // per (module, depth): not yet added to the cache's
     uint64_t expansions_ = 0;
     UnrolledInstance::Scratch scratch_;
 };
 
-// Pins a reader (nullptr: none) while it lives; pins nest.
+// The instances a reader (nullptr: none) hands out while a Pin lives stay valid until it
+// ends (scopes nest). The reader pins itself at its first look-up in the scope, so that a
+// ray that never asks for an expanded instance costs nothing.
 class UnrollCache::Pin {
   public:
     explicit Pin(Reader* r) : r_(r) {
-        if (r_ && r_->pins_++ == 0) r_->cache_.retired_.pin(*r_->slot_);
+        if (r_) ++r_->scopes_;
     }
     ~Pin() {
-        if (r_ && --r_->pins_ == 0) r_->cache_.retired_.unpin(*r_->slot_);
+        if (!r_ || --r_->scopes_ > 0 || !r_->pinned_) return;
+        r_->cache_.retired_.unpin(*r_->slot_);
+        r_->pinned_ = false;
     }
     Pin(const Pin&) = delete;
     Pin& operator=(const Pin&) = delete;
