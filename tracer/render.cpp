@@ -349,7 +349,7 @@ RegionRenderer::RegionRenderer(const Graph& g, const RenderOptions& opt) {
     const auto t1 = std::chrono::steady_clock::now();
     state_ = std::make_unique<State>(g, opt, std::move(bounds), boxOptionsFor(opt));
     state_->scene.useBounds = opt.useBounds;
-    state_->scene.expansionBytesPerThread = opt.expansionBytesPerThread;
+    state_->scene.expansionBytes = opt.expansionBytes;
     figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     state_->figures = figures;
 }

@@ -59,9 +59,9 @@ struct RenderOptions {
     // A sequence's boxes that do not change with the time, kept from frame to frame
     // (SequenceInstanceBoxes, for this graph); null: this render's own table alone.
     std::shared_ptr<SequenceInstanceBoxes> sequenceBoxes;
-    // Expanded instances (unrolled_instances.h), each thread's cache holding at most this
-    // many bytes; 0: none.
-    size_t expansionBytesPerThread = 16u << 20;
+    // Expanded instances (unrolled_instances.h), in one cache shared by the threads that
+    // holds at most this many bytes; 0: none.
+    size_t expansionBytes = 128u << 20;
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
     // Called from worker threads after each tile of each pass (1, or 2 for adaptive

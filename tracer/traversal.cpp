@@ -138,11 +138,18 @@ Tracer::Tracer(const TraceScene& scene)
     if (scene.instanceBoxes_) boxWorker_ = scene.instanceBoxes_->makeWorker();
     if (scene.stepMemoLog2 > 0)
         memo_ = std::make_unique<StepMemo>(g_, scene.memoPlan_, scene.stepMemoLog2);
-    if (scene.instanceBoxes_ && scene.expansionBytesPerThread > 0)
-        expansion_ = std::make_unique<UnrollCache>(scene, scene.expansionBytesPerThread);
+    if (scene.instanceBoxes_ && scene.expansionBytes > 0)
+        expansion_ = std::make_unique<UnrollCache::Reader>(scene.expansionCache());
 }
 
 Tracer::~Tracer() = default;
+
+UnrollCache& TraceScene::expansionCache() const {
+    std::call_once(expansionOnce_, [this] {
+        expansionCache_ = std::make_unique<UnrollCache>(*this, expansionBytes);
+    });
+    return *expansionCache_;
+}
 
 // The unrolled instance to trace instead of walking below S-node n, if there is one.
 const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t depth,
@@ -156,7 +163,7 @@ const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t dept
     return x;
 }
 
-// The instance expanded already by this thread, if there is one: it is traced without its
+// The instance expanded already (by any thread), if there is one: it is traced without its
 // exact box from the cache (which, for an instance too small to be stored there, would be
 // unrolled again), since the expansion clips rays to a box of its own.
 const UnrolledInstance* Tracer::builtAt(NodeId n, const Ctx& c, uint32_t depth,
@@ -207,6 +214,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     paintMaps_.clear();
     inverses_.clear();
     if (g_.axiom == kNone) return false;
+    const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
     if (scene_.useBounds) {

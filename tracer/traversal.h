@@ -42,6 +42,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -55,6 +56,7 @@
 #include "primitives.h"
 #include "semantics.h"
 #include "step_memo.h"
+#include "unroll_cache.h"
 #include "unrolled_instances.h"
 
 namespace pcsg::tracer {
@@ -98,9 +100,11 @@ class TraceScene {
     // The exact boxes of instances (nullptr: static boxes only).
     const InstanceBoxes* instanceBoxes() const { return instanceBoxes_.get(); }
 
-    // Expanded instances (unrolled_instances.h): each tracer's cache may hold this many
-    // bytes; 0 turns them off.
-    size_t expansionBytesPerThread = 16u << 20;
+    // Expanded instances (unrolled_instances.h): one cache shared by all the tracers of
+    // this scene (unroll_cache.h) holds at most this many bytes; 0 turns them off.
+    size_t expansionBytes = 128u << 20;
+    // That cache, made by the first tracer that asks for it (with expansionBytes then).
+    UnrollCache& expansionCache() const;
 
     // Each tracer remembers the results of C- and T-steps (compiler/step_memo.h) in a table
     // of 2^stepMemoLog2 entries (of 336 bytes); 0 turns it off.
@@ -134,6 +138,8 @@ class TraceScene {
     Bounds bounds_;
     uint64_t recursionBound_ = 0;
     std::unique_ptr<InstanceBoxes> instanceBoxes_;
+    mutable std::once_flag expansionOnce_;
+    mutable std::unique_ptr<UnrollCache> expansionCache_;
 };
 
 // The stack ran out although the walk stays within max_depth (the thread's stack is
@@ -161,10 +167,10 @@ class Tracer {
     uint64_t nodeVisits() const {
         return visits_ + (expansion_ ? expansion_->scratch().visits : 0);
     }
-    // Instances this tracer expanded, and what its cache of them holds now.
+    // Instances this tracer expanded, and what the shared cache of them holds now.
     uint64_t expansions() const { return expansion_ ? expansion_->expansions() : 0; }
-    size_t expansionCacheBytes() const { return expansion_ ? expansion_->bytes() : 0; }
-    size_t expansionCacheEntries() const { return expansion_ ? expansion_->entries() : 0; }
+    size_t expansionCacheBytes() const { return expansion_ ? expansion_->cache().bytes() : 0; }
+    size_t expansionCacheEntries() const { return expansion_ ? expansion_->cache().entries() : 0; }
     // The lowest stack address a walk reached (for the stack-size test).
     uintptr_t stackLowWater() const { return lowWater_; }
 
@@ -229,7 +235,7 @@ class Tracer {
     FrameStack frames_;
     InstanceBoxes::WorkerPtr boxWorker_;
     std::unique_ptr<StepMemo> memo_;  // null: scene_.stepMemoLog2 is 0
-    std::unique_ptr<UnrollCache> expansion_;
+    std::unique_ptr<UnrollCache::Reader> expansion_;
     std::vector<double> rootFrame_;
     std::vector<Span> spans_;
     std::vector<std::pair<double, uint32_t>> order_;

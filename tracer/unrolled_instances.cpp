@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <unordered_map>
 
 #include "bounds.h"
 #include "eval.h"
@@ -54,6 +56,7 @@ class Unroller {
         out_.items_.shrink_to_fit();
         out_.children_.shrink_to_fit();
         out_.matrices_.shrink_to_fit();
+        out_.matrixRefs_.shrink_to_fit();
         out_.args_.shrink_to_fit();
         out_.choices_.shrink_to_fit();
     }
@@ -99,7 +102,7 @@ class Unroller {
             out_.levels_ = std::max(out_.levels_, st.state.depth - base_);
             choices_.push_back(kRuleBit | st.rule);
         }
-        if (st.inverse) pending_.push_back(*st.inverse);
+        if (st.inverse) pending_.push_back(matrixIndex(*st.inverse));
         const uint32_t r =
             build(st.child, st.state, pendingBase, st.forward ? edge * *st.forward : edge);
         if (st.inverse) pending_.pop_back();
@@ -167,11 +170,28 @@ class Unroller {
         Node x{};
         x.kind = kind;
         x.material = material;
-        x.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
+        x.firstMatrix = static_cast<uint32_t>(out_.matrixRefs_.size());
         x.matrices = static_cast<uint32_t>(pending_.size() - pendingBase);
-        out_.matrices_.insert(out_.matrices_.end(), pending_.begin() + pendingBase, pending_.end());
+        out_.matrixRefs_.insert(out_.matrixRefs_.end(), pending_.begin() + pendingBase,
+                                pending_.end());
         x.box = inside.isEmpty() ? Box::empty() : paddedBox(transformBox(edge, inside));
         return x;
+    }
+
+    // The index of matrix m in out_.matrices_, where each matrix is stored once (the same
+    // bits: the nodes that use it apply the very numbers the walk would).
+    uint32_t matrixIndex(const Affine& m) {
+        static_assert(sizeof(Affine) == 12 * sizeof(double));
+        uint64_t words[12];
+        std::memcpy(words, &m, sizeof words);
+        uint64_t h = 0x9e3779b97f4a7c15ULL;
+        for (uint64_t w : words) h = (h ^ w) * 0xff51afd7ed558ccdULL;
+        const auto [it, inserted] =
+            matrixIndex_.try_emplace(h, static_cast<uint32_t>(out_.matrices_.size()));
+        if (!inserted && std::memcmp(&out_.matrices_[it->second], &m, sizeof m) == 0)
+            return it->second;
+        out_.matrices_.push_back(m);
+        return static_cast<uint32_t>(out_.matrices_.size() - 1);
     }
 
     // --- the first-hit BVHs of unions ---
@@ -191,12 +211,12 @@ class Unroller {
         for (uint32_t i = 0; i < un.count; ++i) {
             const uint32_t c = out_.children_[un.first + i];
             const Node child = out_.nodes_[c];
-            chain_.insert(chain_.end(), out_.matrices_.begin() + child.firstMatrix,
-                          out_.matrices_.begin() + child.firstMatrix + child.matrices);
+            chain_.insert(chain_.end(), out_.matrixRefs_.begin() + child.firstMatrix,
+                          out_.matrixRefs_.begin() + child.firstMatrix + child.matrices);
             if (isUnion(child) && chain_.size() <= kMaxChain) {
                 Affine to = toU;
                 for (uint32_t k = 0; k < child.matrices; ++k)
-                    to = to * out_.matrices_[child.firstMatrix + k].inverse();
+                    to = to * out_.matrices_[out_.matrixRefs_[child.firstMatrix + k]].inverse();
                 collect(c, to, items);
                 chain_.resize(prefix);
                 continue;
@@ -207,9 +227,9 @@ class Unroller {
                 continue;
             }
             Node copy = child;
-            copy.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
+            copy.firstMatrix = static_cast<uint32_t>(out_.matrixRefs_.size());
             copy.matrices = static_cast<uint32_t>(chain_.size());
-            out_.matrices_.insert(out_.matrices_.end(), chain_.begin(), chain_.end());
+            out_.matrixRefs_.insert(out_.matrixRefs_.end(), chain_.begin(), chain_.end());
             chain_.resize(prefix);
             copy.box =
                 child.box.isEmpty() ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
@@ -290,10 +310,11 @@ class Unroller {
     }
     std::vector<std::unique_ptr<double[]>> frames_;
     size_t framesUsed_ = 0;
-    std::vector<Affine> pending_;
+    std::vector<uint32_t> pending_;                       // matrices (indices in out_.matrices_)
+    std::unordered_map<uint64_t, uint32_t> matrixIndex_;  // by the bits' hash
     std::vector<uint32_t> choices_;
     std::vector<uint32_t> kids_;   // operands of the operators being built
-    std::vector<Affine> chain_;    // collect()'s matrices
+    std::vector<uint32_t> chain_;  // collect()'s matrices (indices)
     std::vector<double> centres_;  // split()'s centres, by node
 };
 
@@ -303,14 +324,15 @@ class Unroller {
 size_t UnrolledInstance::bytes() const {
     return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
-           args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t) +
-           bvh_.capacity() * sizeof(BvhNode) + items_.capacity() * sizeof(uint32_t);
+           matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) +
+           choices_.capacity() * sizeof(uint32_t) + bvh_.capacity() * sizeof(BvhNode) +
+           items_.capacity() * sizeof(uint32_t);
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
     LocalRay rr = r;
     for (uint32_t k = 0; k < node.matrices; ++k) {
-        const Affine& m = matrices_[node.firstMatrix + k];
+        const Affine& m = matrices_[matrixRefs_[node.firstMatrix + k]];
         rr = LocalRay{m.point(rr.o), m.vector(rr.d)};
     }
     return rr;
@@ -318,7 +340,7 @@ LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
 
 Vec3 UnrolledInstance::leave(const Node& node, Vec3 normal) const {
     for (uint32_t k = node.matrices; k-- > 0;)
-        normal = matrices_[node.firstMatrix + k].transposedVector(normal);
+        normal = matrices_[matrixRefs_[node.firstMatrix + k]].transposedVector(normal);
     return normal;
 }
 
@@ -486,88 +508,17 @@ size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
 
 // ---------------------------------------------------------------------------------------
 
-UnrollCache::UnrollCache(const TraceScene& scene, size_t maxBytes)
-    : scene_(scene),
-      maxBytes_(maxBytes),
-      yield_(scene.graph().modules.size() * (scene.graph().scene.settings.maxDepth + 2)),
-      levels_(scene.graph().scene.settings.maxDepth + 2) {}
-
-UnrollCache::~UnrollCache() = default;
-
-void UnrollCache::evict() {
-    while (bytes_ > maxBytes_ && lru_.size() > 1) {
-        const Entry& last = lru_.back();
-        bytes_ -= last.bytes;
-        index_.erase(last.key);
-        lru_.pop_back();
-    }
-}
-
-const UnrolledInstance* UnrollCache::built(const InstanceBoxes::Key& key, NodeId select,
-                                           uint32_t depth) {
-    if (depth >= levels_ || lru_.empty()) return nullptr;
-    Yield& y = yield_[static_cast<size_t>(scene_.graph().nodes[select].payload) * levels_ + depth];
-    if (y.off) return nullptr;
-    const auto it = index_.find(key);
-    if (it == index_.end() || !it->second->instance) return nullptr;
-    lru_.splice(lru_.begin(), lru_, it->second);
-    ++y.used;
-    return lru_.front().instance.get();
-}
-
-const UnrolledInstance* UnrollCache::get(NodeId select, uint32_t depth, const double* frame,
-                                         uint64_t path) {
-    return get(scene_.instanceBoxes()->keyOf(select, frame, path), select, depth, frame, path);
-}
-
-const UnrolledInstance* UnrollCache::get(const InstanceBoxes::Key& key, NodeId select,
-                                         uint32_t depth, const double* frame, uint64_t path) {
-    if (depth >= levels_) return nullptr;
-    Yield& y = yield_[static_cast<size_t>(scene_.graph().nodes[select].payload) * levels_ + depth];
-    if (y.off) return nullptr;
-    const InstanceBoxes* boxes = scene_.instanceBoxes();
-    constexpr size_t kNoteBytes = sizeof(Entry) + 64;
-    const auto it = index_.find(key);
-    if (it == index_.end()) {
-        // The first meeting: only a note.
-        lru_.push_front(Entry{key, nullptr, false, kNoteBytes});
-        index_.emplace(key, lru_.begin());
-        bytes_ += kNoteBytes;
-        evict();
-        return nullptr;
-    }
-    lru_.splice(lru_.begin(), lru_, it->second);
-    Entry& e = lru_.front();
-    if (e.tooLarge) return nullptr;
-    if (e.instance) {
-        ++y.used;
-        return e.instance.get();
-    }
-    // Expansions here that are used less than four times each on average do not pay.
-    constexpr uint64_t kTrial = 64, kUses = 4;
-    if (y.built >= kTrial && y.used < kUses * y.built) {
-        y.off = true;
-        return nullptr;
-    }
-    // The second meeting: expand.
+std::unique_ptr<UnrolledInstance> UnrolledInstance::expand(const TraceScene& scene, NodeId select,
+                                                           uint32_t depth, const double* frame,
+                                                           uint64_t path, uint64_t maxVisits) {
     auto x = std::make_unique<UnrolledInstance>();
-    Unroller builder(scene_, *x, 4 * boxes->maxUnrollWeight());
+    Unroller builder(scene, *x, maxVisits);
     try {
         builder.run(select, depth, frame, path);
     } catch (const TooLarge&) {
-        e.tooLarge = true;
         return nullptr;
     }
-    ++expansions_;
-    ++y.built;
-    ++y.used;
-    const size_t b = x->bytes() + kNoteBytes;
-    bytes_ += b - e.bytes;
-    e.bytes = b;
-    e.instance = std::move(x);
-    const UnrolledInstance* result = e.instance.get();
-    evict();
-    return result;
+    return x;
 }
 
 }  // namespace pcsg::tracer

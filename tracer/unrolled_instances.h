@@ -16,11 +16,12 @@
 //  - Which instances: those at the depths where InstanceBoxes has seen sub-graphs of a
 //    few dozen to a thousand node visits (InstanceBoxes::unrollAt); the first S-node of
 //    such a depth on a ray's path is expanded with everything below it.
-//  - When: an instance is expanded the second time a thread meets it (the first time
-//    only leaves a note), so that instances a single ray passes do not pay for it; and a
-//    thread stops expanding at a depth where the expansions are not used several times
-//    each (a terrain's sub-triangles, each seen by a few rays only).
-//  - Where: per thread (no locks), least recently used first out, within a byte budget.
+//  - When: an instance is expanded the second time it is met, by any thread (the first
+//    time only leaves a note), so that instances a single ray passes do not pay for it; and
+//    expansion stops at a depth where the expansions are not used several times each (a
+//    terrain's sub-triangles, each seen by a few rays only).
+//  - Where: in one cache shared by the tracer threads (unroll_cache.h), within a byte
+//    budget for all of them.
 //  - Materials and tie-break keys depend on where an instance is used, not on what it
 //    is: a primitive without a paint above it inside the instance takes the caller's
 //    material (and the frame of the caller's paint node, for patterns), and each hit's
@@ -30,9 +31,7 @@
 #pragma once
 
 #include <cstdint>
-#include <list>
 #include <memory>
-#include <unordered_map>
 #include <vector>
 
 #include "geometry.h"
@@ -56,6 +55,7 @@ class UnrolledInstance {
         PrimitiveKind prim = PrimitiveKind::Empty;
         uint32_t material = kInherit;            // primitives: the innermost paint inside
         uint32_t firstMatrix = 0, matrices = 0;  // inverse matrices applied on entering
+                                                 // (matrixRefs_[firstMatrix..])
         uint32_t first = 0, count = 0;           // operators: children; primitives: args
         uint32_t firstChoice = 0, choices = 0;   // the path from the S-node (hit sources)
         uint32_t bvh = kNone;                    // unions: the root of their first-hit BVH
@@ -95,6 +95,14 @@ class UnrolledInstance {
     size_t spans(const LocalRay& r, double tmin, double tmax, std::vector<Span>& spans,
                  const Use& use, Scratch& s) const;
 
+    // Expands the S-node instance (select, frame, path) at `depth`: nullptr when the
+    // expansion takes more than `maxVisits` node visits or meets a paint node whose
+    // pattern needs the node's frame (the graph walk records it). Throws RuntimeError
+    // (without this S-node in its module path) when unrolling meets a run-time error.
+    static std::unique_ptr<UnrolledInstance> expand(const TraceScene& scene, NodeId select,
+                                                    uint32_t depth, const double* frame,
+                                                    uint64_t path, uint64_t maxVisits);
+
     const Box& box() const { return nodes_[root_].box; }
     bool empty() const { return root_ == kNone; }
     // S-nodes nested below the instance's own (the expansion is used only where the
@@ -120,65 +128,14 @@ class UnrolledInstance {
 
     std::vector<Node> nodes_;
     std::vector<uint32_t> children_;
-    std::vector<Affine> matrices_;
+    std::vector<Affine> matrices_;      // each inverse matrix met, once
+    std::vector<uint32_t> matrixRefs_;  // the nodes' matrices (indices in matrices_)
     std::vector<double> args_;
     std::vector<uint32_t> choices_;  // bit 31: a rule of an S-node, else an operand
     std::vector<BvhNode> bvh_;
     std::vector<uint32_t> items_;
     uint32_t root_ = kNone;
     uint32_t levels_ = 0;
-};
-
-// One thread's cache of expanded instances.
-class UnrollCache {
-  public:
-    UnrollCache(const TraceScene& scene, size_t maxBytes);
-    ~UnrollCache();
-
-    // The expanded instance of the S-node instance (select, frame, path) at `depth`, or
-    // nullptr (not worth expanding yet, or too large). Throws RuntimeError (without this
-    // S-node in its module path) when unrolling meets a run-time error.
-    const UnrolledInstance* get(NodeId select, uint32_t depth, const double* frame, uint64_t path);
-    // The same, with the instance's key (InstanceBoxes::keyOf) computed by the caller.
-    const UnrolledInstance* get(const InstanceBoxes::Key& key, NodeId select, uint32_t depth,
-                                const double* frame, uint64_t path);
-
-    // The instance if it is expanded already (counted as a use), else nullptr: no note,
-    // no expansion.
-    const UnrolledInstance* built(const InstanceBoxes::Key& key, NodeId select, uint32_t depth);
-
-    UnrolledInstance::Scratch& scratch() { return scratch_; }
-    uint64_t expansions() const { return expansions_; }
-    size_t bytes() const { return bytes_; }
-    size_t entries() const { return lru_.size(); }
-
-  private:
-    struct Entry {
-        InstanceBoxes::Key key;
-        std::unique_ptr<UnrolledInstance> instance;  // nullptr: met once, or too large
-        bool tooLarge = false;
-        size_t bytes = 0;
-    };
-    struct KeyHash {
-        size_t operator()(const InstanceBoxes::Key& k) const { return static_cast<size_t>(k.b); }
-    };
-
-    void evict();
-
-    // Per (module, depth): expansions made, and uses of them.
-    struct Yield {
-        uint64_t built = 0, used = 0;
-        bool off = false;
-    };
-    const TraceScene& scene_;
-    size_t maxBytes_;
-    std::vector<Yield> yield_;
-    uint32_t levels_;
-    size_t bytes_ = 0;
-    uint64_t expansions_ = 0;
-    std::list<Entry> lru_;  // most recently used first
-    std::unordered_map<InstanceBoxes::Key, std::list<Entry>::iterator, KeyHash> index_;
-    UnrolledInstance::Scratch scratch_;
 };
 
 }  // namespace pcsg::tracer

@@ -95,7 +95,7 @@ uint64_t compareWithGraphWalk(const char* text, double spread, int minHits = 200
     if (!c->graph) return 0;
     const Graph& g = *c->graph;
     TraceScene plain(g, computeBounds(g), true, eager());
-    plain.expansionBytesPerThread = 0;
+    plain.expansionBytes = 0;
     TraceScene expanding(g, computeBounds(g), true, eager());
     Tracer a(plain), b(expanding);
     const Rays r = rays(1500, 7, spread);
@@ -155,12 +155,14 @@ TEST(ExpandedInstances, AChainOfUnionsGetsAHierarchyAndTheSameHits) {
     const Graph& g = *c->graph;
     TraceScene scene(g, computeBounds(g), true, eager());
     UnrollCache cache(scene, 1u << 20);
+    UnrollCache::Reader reader(cache);
+    const UnrollCache::Pin pin(&reader);
     std::vector<double> root(g.slotCount()), frame(g.slotCount());
     initFrame(g, root.data());
     applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, frame.data());
     const NodeId s = g.child(g.axiom);
-    EXPECT_EQ(cache.get(s, 1, frame.data(), kRootPath), nullptr);  // the first meeting: a note
-    const UnrolledInstance* x = cache.get(s, 1, frame.data(), kRootPath);
+    EXPECT_EQ(reader.get(s, 1, frame.data(), kRootPath), nullptr);  // the first meeting: a note
+    const UnrolledInstance* x = reader.get(s, 1, frame.data(), kRootPath);
     ASSERT_NE(x, nullptr);
     // 22 primitives under one hierarchy: at least 22 / 4 leaves.
     EXPECT_GE(x->bvhNodes(), 6u);
@@ -171,7 +173,7 @@ TEST(ExpandedInstances, TheCacheStaysWithinItsBudget) {
     auto c = compile(kPlant);
     ASSERT_TRUE(c->graph);
     TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
-    scene.expansionBytesPerThread = 8 * 1024;
+    scene.expansionBytes = 8 * 1024;
     Tracer t(scene);
     const Rays r = rays(2000, 11, 1.5);
     for (int round = 0; round < 2; ++round)
@@ -182,8 +184,7 @@ TEST(ExpandedInstances, TheCacheStaysWithinItsBudget) {
     EXPECT_GT(t.expansions(), 0u);
     EXPECT_GT(t.expansionCacheBytes(), 0u);
     // What stays in a tracer's cache fits its budget, unless it is the one entry in use.
-    EXPECT_TRUE(t.expansionCacheBytes() <= scene.expansionBytesPerThread ||
-                t.expansionCacheEntries() == 1)
+    EXPECT_TRUE(t.expansionCacheBytes() <= scene.expansionBytes || t.expansionCacheEntries() == 1)
         << t.expansionCacheBytes() << " bytes in " << t.expansionCacheEntries() << " entries";
 }
 

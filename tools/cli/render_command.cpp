@@ -70,7 +70,7 @@ struct RenderCommandOptions {
     bool noBounds = false;
     bool noInstanceBoxes = false;
     size_t boxCacheMb = 64;
-    size_t expansionCacheMb = 16;
+    size_t expansionCacheMb = 128;
     uint64_t countVisits = 20'000'000;
     double clock = 0;  // --clock: the still's time
     int frame = 1;     // --frame: the still's frame number
@@ -152,7 +152,7 @@ tracer::RenderOptions tracerOptions(const RenderCommandOptions& o) {
     ro.useBounds = !o.noBounds;
     ro.instanceBoxes = !o.noInstanceBoxes;
     ro.instanceBoxBytes = o.boxCacheMb << 20;
-    ro.expansionBytesPerThread = o.expansionCacheMb << 20;
+    ro.expansionBytes = o.expansionCacheMb << 20;
     return ro;
 }
 
@@ -846,9 +846,9 @@ void addRenderCommand(CLI::App& app, int& status) {
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--expansion-cache-mb", o->expansionCacheMb,
-                    "Memory limit per thread, in MB, of the cache of expanded sub-graph "
-                    "instances (small instances unrolled once and traced as flat arrays; 0: "
-                    "none; the image is the same)")
+                    "Memory limit in MB of the cache of expanded sub-graph instances, shared "
+                    "by all threads (small instances unrolled once and traced as flat arrays; "
+                    "0: none; the image is the same)")
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--count-visits", o->countVisits,

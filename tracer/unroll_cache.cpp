@@ -1,0 +1,222 @@
+// The shared cache of expanded instances: see unroll_cache.h.
+#include "unroll_cache.h"
+
+#include <tbb/spin_rw_mutex.h>
+
+#include <deque>
+#include <unordered_map>
+
+#include "traversal.h"
+
+namespace pcsg::tracer {
+
+namespace {
+
+struct KeyHash {
+    size_t operator()(const InstanceBoxes::Key& k) const { return static_cast<size_t>(k.b); }
+};
+
+// What a note costs (the entry, the map's node, its key in the eviction queue).
+constexpr size_t kNoteBytes = 128;
+// Uses a reader counts before adding them to the cache's figures.
+constexpr uint32_t kUseBatch = 32;
+// Expansions at a (module, depth) that are used less than kUses times each on average
+// (judged from kTrial expansions on) do not pay.
+constexpr uint64_t kTrial = 64, kUses = 4;
+
+}  // namespace
+
+struct UnrollCache::Entry {
+    enum class State : uint8_t { Note, Building, Built, TooLarge };
+    State state = State::Note;                   // (written under the shard's write lock)
+    std::atomic<bool> referenced{false};         // used since the eviction hand passed
+    std::unique_ptr<UnrolledInstance> instance;  // Built
+    size_t bytes = kNoteBytes;
+};
+
+struct alignas(64) UnrollCache::Shard {
+    mutable tbb::spin_rw_mutex mutex;
+    std::unordered_map<InstanceBoxes::Key, Entry, KeyHash> map;
+};
+
+struct UnrollCache::Yield {
+    std::atomic<uint64_t> built{0}, used{0};
+    std::atomic<bool> off{false};
+};
+
+UnrollCache::UnrollCache(const TraceScene& scene, size_t maxBytes)
+    : scene_(scene),
+      maxBytes_(maxBytes),
+      levels_(scene.graph().scene.settings.maxDepth + 2),
+      shards_(std::make_unique<Shard[]>(kShards)),
+      yield_(std::make_unique<Yield[]>(scene.graph().modules.size() * levels_)) {}
+
+UnrollCache::~UnrollCache() = default;
+
+UnrollCache::Shard& UnrollCache::shardOf(const InstanceBoxes::Key& k) const {
+    return shards_[k.a % kShards];
+}
+
+size_t UnrollCache::yieldIndex(NodeId select, uint32_t depth) const {
+    return static_cast<size_t>(scene_.graph().nodes[select].payload) * levels_ + depth;
+}
+
+// Second chance (CLOCK): entries used since the hand last passed them (and those in
+// construction) go to the back of the queue; the others leave, until the cache fits.
+// One evicting thread at a time (the queue's mutex, then a shard's lock).
+void UnrollCache::evict() {
+    std::vector<std::unique_ptr<UnrolledInstance>> out;
+    size_t freed = 0;
+    {
+        std::lock_guard<std::mutex> hand(queueMutex_);
+        for (size_t turns = 2 * queue_.size(); turns > 0 && !queue_.empty(); --turns) {
+            if (bytes_.load(std::memory_order_relaxed) <= maxBytes_) break;
+            const InstanceBoxes::Key k = queue_.front();
+            queue_.pop_front();
+            Shard& s = shardOf(k);
+            tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
+            const auto it = s.map.find(k);
+            if (it == s.map.end()) continue;  // (never: a key is queued while it is stored)
+            Entry& e = it->second;
+            if (e.state == Entry::State::Building ||
+                e.referenced.exchange(false, std::memory_order_relaxed)) {
+                queue_.push_back(k);
+                continue;
+            }
+            if (e.instance) {
+                freed += e.bytes;
+                out.push_back(std::move(e.instance));
+            }
+            bytes_.fetch_sub(e.bytes, std::memory_order_relaxed);
+            entries_.fetch_sub(1, std::memory_order_relaxed);
+            s.map.erase(it);
+        }
+    }
+    if (out.empty() && retired_.pendingBytes() > 0) retired_.reclaim();
+    retired_.retire(out, freed);
+}
+
+// ---------------------------------------------------------------------------------------
+
+UnrollCache::Reader::Reader(UnrollCache& cache)
+    : cache_(cache),
+      slot_(cache.retired_.join()),
+      uses_(cache.scene_.graph().modules.size() * cache.levels_, 0) {}
+
+UnrollCache::Reader::~Reader() {
+    for (size_t y = 0; y < uses_.size(); ++y)
+        if (uses_[y]) cache_.yield_[y].used.fetch_add(uses_[y], std::memory_order_relaxed);
+    cache_.retired_.leave(slot_);
+}
+
+void UnrollCache::Reader::used(size_t y) {
+    if (++uses_[y] < kUseBatch) return;
+    cache_.yield_[y].used.fetch_add(uses_[y], std::memory_order_relaxed);
+    uses_[y] = 0;
+}
+
+const UnrolledInstance* UnrollCache::Reader::built(const InstanceBoxes::Key& key, NodeId select,
+                                                   uint32_t depth) {
+    if (depth >= cache_.levels_ || cache_.entries() == 0) return nullptr;
+    const size_t y = cache_.yieldIndex(select, depth);
+    if (cache_.yield_[y].off.load(std::memory_order_relaxed)) return nullptr;
+    Shard& s = cache_.shardOf(key);
+    pinOnce();
+    tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
+    const auto it = s.map.find(key);
+    if (it == s.map.end() || it->second.state != Entry::State::Built) return nullptr;
+    Entry& e = it->second;
+    if (!e.referenced.load(std::memory_order_relaxed))
+        e.referenced.store(true, std::memory_order_relaxed);
+    used(y);
+    return e.instance.get();
+}
+
+const UnrolledInstance* UnrollCache::Reader::get(NodeId select, uint32_t depth, const double* frame,
+                                                 uint64_t path) {
+    return get(cache_.scene_.instanceBoxes()->keyOf(select, frame, path), select, depth, frame,
+               path);
+}
+
+const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, NodeId select,
+                                                 uint32_t depth, const double* frame,
+                                                 uint64_t path) {
+    if (const UnrolledInstance* x = built(key, select, depth)) return x;
+    if (depth >= cache_.levels_) return nullptr;
+    const size_t y = cache_.yieldIndex(select, depth);
+    Yield& yield = cache_.yield_[y];
+    if (yield.off.load(std::memory_order_relaxed)) return nullptr;
+    Shard& s = cache_.shardOf(key);
+    pinOnce();
+    Entry* e = nullptr;
+    bool inserted = false;
+    {
+        tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
+        const auto emplaced = s.map.try_emplace(key);
+        const auto it = emplaced.first;
+        inserted = emplaced.second;
+        if (inserted) {  // the first meeting: only a note
+            cache_.bytes_.fetch_add(kNoteBytes, std::memory_order_relaxed);
+            cache_.entries_.fetch_add(1, std::memory_order_relaxed);
+        } else if (it->second.state == Entry::State::Built) {  // (built meanwhile)
+            it->second.referenced.store(true, std::memory_order_relaxed);
+            used(y);
+            return it->second.instance.get();
+        } else if (it->second.state == Entry::State::Note) {
+            const uint64_t b = yield.built.load(std::memory_order_relaxed);
+            if (b >= kTrial && yield.used.load(std::memory_order_relaxed) + uses_[y] < kUses * b) {
+                yield.off.store(true, std::memory_order_relaxed);
+                return nullptr;
+            }
+            it->second.state = Entry::State::Building;  // the second meeting: expand
+            e = &it->second;
+        }
+    }
+    if (!e) {
+        if (inserted) {  // (queued after the shard's lock: the hand takes the queue first)
+            std::lock_guard<std::mutex> hand(cache_.queueMutex_);
+            cache_.queue_.push_back(key);
+        }
+        if (cache_.bytes() > cache_.maxBytes_) cache_.evict();
+        return nullptr;
+    }
+    return expand(s, *e, y, select, depth, frame, path);
+}
+
+// Expands the instance of entry e (in construction, so that it stays in its shard while
+// no lock is held).
+const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e, size_t y, NodeId select,
+                                                    uint32_t depth, const double* frame,
+                                                    uint64_t path) {
+    std::unique_ptr<UnrolledInstance> x;
+    try {
+        x = UnrolledInstance::expand(cache_.scene_, select, depth, frame, path,
+                                     4 * cache_.scene_.instanceBoxes()->maxUnrollWeight());
+    } catch (...) {
+        tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
+        e.state = Entry::State::Note;
+        throw;
+    }
+    const UnrolledInstance* result = x.get();
+    {
+        tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
+        if (!x) {
+            e.state = Entry::State::TooLarge;
+            return nullptr;
+        }
+        const size_t b = x->bytes() + kNoteBytes;
+        cache_.bytes_.fetch_add(b - e.bytes, std::memory_order_relaxed);
+        e.bytes = b;
+        e.instance = std::move(x);
+        e.referenced.store(true, std::memory_order_relaxed);  // (the one just built stays)
+        e.state = Entry::State::Built;
+    }
+    ++expansions_;
+    cache_.expansions_.fetch_add(1, std::memory_order_relaxed);
+    cache_.yield_[y].built.fetch_add(1, std::memory_order_relaxed);
+    used(y);
+    if (cache_.bytes() > cache_.maxBytes_ || cache_.retiredBytes() > 0) cache_.evict();
+    return result;
+}
+
+}  // namespace pcsg::tracer

@@ -1,0 +1,138 @@
+// The cache of expanded instances (unrolled_instances.h) of one scene, shared by all its
+// tracer threads: each instance is expanded once, for every thread, within one byte
+// budget for all of them.
+//
+//  - Reads: shards, each a hash map behind a reader-writer lock (a use takes the read
+//    lock of one shard of 64); each thread uses the cache through a Reader of its own.
+//  - Lifetime: instances are immutable once built. An instance evicted while another
+//    thread traces it is freed only when that thread has unpinned (deferred_free.h): a
+//    tracer's Reader is pinned from its first look-up in a ray to the ray's end.
+//  - Notes: the first meeting of an instance, by any thread, leaves a note; the second,
+//    by any thread, expands it. While one thread expands an instance it is marked "in
+//    construction", and the others walk the graph below it meanwhile, not wait.
+//  - Eviction: second chance (CLOCK) over all entries, in the order of insertion, until
+//    the notes and instances fit the budget again; an instance in construction stays,
+//    and the one just built gets its second chance.
+//  - Per (module, depth): expansions made and uses of them, counted over all threads
+//    (each thread adds its uses in batches); where the expansions are used less than four
+//    times each, expansion stops. None of this changes a hit: an expanded instance gives
+//    the same surfaces, bit for bit, as the graph walk.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "deferred_free.h"
+#include "instance_boxes.h"
+#include "unrolled_instances.h"
+
+namespace pcsg::tracer {
+
+class UnrollCache {
+  public:
+    UnrollCache(const TraceScene& scene, size_t maxBytes);
+    ~UnrollCache();  // (after its readers)
+    UnrollCache(const UnrollCache&) = delete;
+    UnrollCache& operator=(const UnrollCache&) = delete;
+
+    class Reader;
+    class Pin;
+
+    // Instances expanded (all threads); bytes and entries held now (notes and instances);
+    // bytes of evicted instances not freed yet (a reader may still hold them).
+    uint64_t expansions() const { return expansions_.load(std::memory_order_relaxed); }
+    size_t bytes() const { return bytes_.load(std::memory_order_relaxed); }
+    size_t entries() const { return entries_.load(std::memory_order_relaxed); }
+    size_t retiredBytes() const { return retired_.pendingBytes(); }
+    size_t maxBytes() const { return maxBytes_; }
+
+  private:
+    struct Entry;
+    struct Shard;
+    struct Yield;
+    static constexpr size_t kShards = 64;
+
+    Shard& shardOf(const InstanceBoxes::Key& k) const;
+    size_t yieldIndex(NodeId select, uint32_t depth) const;
+    void evict();
+
+    const TraceScene& scene_;
+    const size_t maxBytes_;
+    const uint32_t levels_;
+    std::unique_ptr<Shard[]> shards_;
+    std::unique_ptr<Yield[]> yield_;
+    std::atomic<size_t> bytes_{0}, entries_{0};
+    std::atomic<uint64_t> expansions_{0};
+    std::mutex queueMutex_;
+    std::deque<InstanceBoxes::Key> queue_;  // every entry, in the order of insertion
+    DeferredFree retired_;
+};
+
+// One thread's use of the cache: its pins, its scratch space, its batch of use counts.
+class UnrollCache::Reader {
+  public:
+    explicit Reader(UnrollCache& cache);
+    ~Reader();
+    Reader(const Reader&) = delete;
+    Reader& operator=(const Reader&) = delete;
+
+    // The expanded instance of the S-node instance (select, frame, path) at `depth`, or
+    // nullptr (not worth expanding yet, being expanded by another thread, or too large).
+    // Valid until the end of the Pin scope it was asked in. Throws RuntimeError (without
+    // this S-node in its module path) when unrolling meets a run-time error.
+    const UnrolledInstance* get(const InstanceBoxes::Key& key, NodeId select, uint32_t depth,
+                                const double* frame, uint64_t path);
+    const UnrolledInstance* get(NodeId select, uint32_t depth, const double* frame, uint64_t path);
+    // The instance if it is expanded already (counted as a use), else nullptr: no note,
+    // no expansion.
+    const UnrolledInstance* built(const InstanceBoxes::Key& key, NodeId select, uint32_t depth);
+
+    UnrolledInstance::Scratch& scratch() { return scratch_; }
+    uint64_t expansions() const { return expansions_; }  // made by this thread
+    UnrollCache& cache() { return cache_; }
+
+  private:
+    friend class Pin;
+    void pinOnce() {  // (before the first look-up in a Pin scope)
+        if (pinned_) return;
+        cache_.retired_.pin(*slot_);
+        pinned_ = true;
+    }
+    const UnrolledInstance* expand(Shard& s, Entry& e, size_t y, NodeId select, uint32_t depth,
+                                   const double* frame, uint64_t path);
+    void used(size_t y);
+
+    UnrollCache& cache_;
+    DeferredFree::Slot* slot_;
+    uint32_t scopes_ = 0;  // nested Pin scopes
+    bool pinned_ = false;
+    std::vector<uint32_t> uses_;  // per (module, depth): not yet added to the cache's
+    uint64_t expansions_ = 0;
+    UnrolledInstance::Scratch scratch_;
+};
+
+// The instances a reader (nullptr: none) hands out while a Pin lives stay valid until it
+// ends (scopes nest). The reader pins itself at its first look-up in the scope, so that a
+// ray that never asks for an expanded instance costs nothing.
+class UnrollCache::Pin {
+  public:
+    explicit Pin(Reader* r) : r_(r) {
+        if (r_) ++r_->scopes_;
+    }
+    ~Pin() {
+        if (!r_ || --r_->scopes_ > 0 || !r_->pinned_) return;
+        r_->cache_.retired_.unpin(*r_->slot_);
+        r_->pinned_ = false;
+    }
+    Pin(const Pin&) = delete;
+    Pin& operator=(const Pin&) = delete;
+
+  private:
+    Reader* r_;
+};
+
+}  // namespace pcsg::tracer

@@ -1,0 +1,193 @@
+// The shared cache of expanded instances (unroll_cache.h): threads asking for the same
+// instance get one object, built once; the cache stays within its byte budget whatever
+// the threads do; an instance evicted while a reader is pinned stays intact until the
+// reader unpins; tracers on several threads find the same hits as the graph walk.
+#include "unroll_cache.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <thread>
+
+#include "bounds.h"
+#include "test_support.h"
+#include "traversal.h"
+
+namespace pcsg::tracer {
+namespace {
+
+using testing::compile;
+
+// Expand wherever an instance is met a second time, from the first instance on.
+InstanceBoxOptions eager() {
+    InstanceBoxOptions o;
+    o.trial = 1;
+    o.minExpandWeight = 1;
+    o.maxUnrollWeight = 1u << 20;
+    return o;
+}
+
+// A flower head of p petals: each value of p is an instance of its own.
+const char* kFlower = R"(
+material petal { color <1, 1, 0.9> }
+{p = 21} F
+F if(p > 0, 2, 1)
+1: F -> scale(0.2, 0.2, 0.1) sphere
+2: F -> paint(petal) roty(-12 - 10*mod(p, 2)) move(0.45, 0, 0) scale(0.36, 0.08, 0.02) sphere ∪
+        {p = p-1} rotz(360/21) F
+)";
+
+const char* kPlant = R"(
+material bark { color <0.4, 0.3, 0.2> }
+material leaf { color <0.2, 0.6, 0.1>  phong 0.3 }
+settings { seed 3 }
+{n = 6; a = 35} P
+P if(n > 0, choose(0.7, 0.3) + 1, 1)
+1: P -> paint(leaf) (move(0,0,0.3) scale(0.3,0.1,0.3) sphere ∩ cylinder)
+2: P -> paint(bark) scale(0.1,0.1,1) cylinder ∪
+        {n = n-1} move(0,0,1) rotz(rand()*360) (rotx(a) uscale(0.7) P ∪ roty(-a) uscale(0.6) P)
+3: P -> torus(0.5, 0.1) ∪ {n = n-1} move(0,0,0.2) zshear(0.2, 0.1) flipxz uscale(0.8) P
+)";
+
+// The flower's S-node and the frame of its instance with p petals.
+struct Flower {
+    explicit Flower(const Graph& graph) : g(graph), frame(g.slotCount()) {
+        std::vector<double> root(g.slotCount());
+        initFrame(g, root.data());
+        applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, frame.data());
+        select = g.child(g.axiom);
+        for (size_t k = 0; k < frame.size(); ++k)
+            if (frame[k] == 21) slot = k;
+    }
+    const UnrolledInstance* get(UnrollCache::Reader& r, int petals) {
+        frame[slot] = petals;
+        return r.get(select, 1, frame.data(), kRootPath);
+    }
+    const Graph& g;
+    std::vector<double> frame;
+    NodeId select = kNone;
+    size_t slot = SIZE_MAX;
+};
+
+// The nearest hit of a ray through an instance, to compare instances by what they hold.
+Hit hitOf(const UnrolledInstance& x, UnrollCache::Reader& r) {
+    Hit h;
+    double tmax = 1e9;
+    x.first(LocalRay{{0.1, -5, 0}, Vec3{0, 1, 0}}, 1e-6, tmax, h, {kRootPath, 0, 0}, false,
+            r.scratch());
+    return h;
+}
+
+TEST(UnrollCache, ThreadsAskingForOneInstanceGetOneObjectBuiltOnce) {
+    auto c = compile(kFlower);
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    UnrollCache cache(scene, 64u << 20);
+    constexpr int kThreads = 4;
+    std::vector<const UnrolledInstance*> got(kThreads, nullptr);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t)
+        threads.emplace_back([&, t] {
+            Flower f(*c->graph);
+            UnrollCache::Reader reader(cache);
+            // nullptr while it is a note or in construction elsewhere
+            for (int i = 0; i < 100000 && !got[t]; ++i) {
+                const UnrollCache::Pin pin(&reader);
+                got[t] = f.get(reader, 21);
+            }
+        });
+    for (auto& t : threads) t.join();
+    ASSERT_NE(got[0], nullptr);
+    for (int t = 1; t < kThreads; ++t) EXPECT_EQ(got[t], got[0]) << "thread " << t;
+    EXPECT_EQ(cache.expansions(), 1u);
+}
+
+TEST(UnrollCache, AnInstanceEvictedWhileInUseStaysIntactUntilItsReaderUnpins) {
+    auto c = compile(kFlower);
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    UnrollCache cache(scene, 2048);  // room for notes and small instances
+    Flower fa(*c->graph), fb(*c->graph);
+    ASSERT_NE(fa.slot, SIZE_MAX);
+    UnrollCache::Reader a(cache);
+    auto b = std::make_unique<UnrollCache::Reader>(cache);
+    const UnrolledInstance* x = nullptr;
+    {
+        const UnrollCache::Pin pin(&a);
+        for (int i = 0; i < 2 && !x; ++i) x = fa.get(a, 21);
+        ASSERT_NE(x, nullptr);
+        const Hit before = hitOf(*x, a);
+        ASSERT_TRUE(before.valid);
+        const Box box = x->box();
+        // Another reader fills the cache: the instance leaves it, but is not freed.
+        for (int p = 1; p < 21; ++p)
+            for (int i = 0; i < 2; ++i) {
+                const UnrollCache::Pin pinB(b.get());
+                fb.get(*b, p);
+            }
+        EXPECT_GT(cache.retiredBytes(), 0u);
+        const Hit after = hitOf(*x, a);  // (ASan: a use after free if it had been freed)
+        EXPECT_EQ(after.t, before.t);
+        EXPECT_EQ(after.key, before.key);
+        EXPECT_EQ(x->box().lo.x, box.lo.x);
+        EXPECT_EQ(x->box().hi.z, box.hi.z);
+    }
+    b.reset();  // (a reader leaving frees what no pinned reader holds)
+    EXPECT_EQ(cache.retiredBytes(), 0u);
+}
+
+TEST(UnrollCache, TracersOnSeveralThreadsStayWithinOneBudgetAndFindTheGraphWalksHits) {
+    auto c = compile(kPlant);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene plain(g, computeBounds(g), true, eager());
+    plain.expansionBytes = 0;
+    TraceScene shared(g, computeBounds(g), true, eager());
+    shared.expansionBytes = 24 * 1024;
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<Vec3> o, d;
+    for (int i = 0; i < 3000; ++i) {
+        o.push_back(Vec3{u(rng) * 5, -6 + u(rng), u(rng) * 5});
+        d.push_back(normalize(Vec3{u(rng) * 1.5, u(rng) * 1.5, u(rng) * 1.5 + 1.5} - o.back()));
+    }
+    std::vector<SurfaceHit> expected(o.size());
+    std::vector<char> found(o.size());
+    Tracer walk(plain);
+    for (size_t i = 0; i < o.size(); ++i)
+        found[i] = walk.firstHit(o[i], d[i], 1e-4, 1e7, expected[i]);
+    constexpr int kThreads = 3;
+    std::vector<int> mismatches(kThreads, 0);
+    std::vector<uint64_t> expansions(kThreads, 0);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t)
+        threads.emplace_back([&, t] {
+            Tracer tracer(shared);
+            for (int round = 0; round < 3; ++round)
+                for (size_t k = 0; k < o.size(); ++k) {
+                    const size_t i = (k * (t + 1) + round * 977) % o.size();
+                    SurfaceHit h;
+                    const bool f = tracer.firstHit(o[i], d[i], 1e-4, 1e7, h);
+                    if (f != bool(found[i]) ||
+                        (f && (h.t != expected[i].t || h.material != expected[i].material ||
+                               h.normal.x != expected[i].normal.x)))
+                        ++mismatches[t];
+                }
+            expansions[t] = tracer.expansions();
+        });
+    for (auto& t : threads) t.join();
+    uint64_t total = 0;
+    for (int t = 0; t < kThreads; ++t) {
+        EXPECT_EQ(mismatches[t], 0) << "thread " << t;
+        total += expansions[t];
+    }
+    const UnrollCache& cache = shared.expansionCache();
+    EXPECT_GT(total, 0u);
+    EXPECT_EQ(total, cache.expansions());
+    EXPECT_GT(cache.bytes(), 0u);
+    EXPECT_LE(cache.bytes(), cache.maxBytes()) << cache.entries() << " entries";
+    EXPECT_EQ(cache.retiredBytes(), 0u);  // the tracers are gone: nothing is held
+}
+
+}  // namespace
+}  // namespace pcsg::tracer
