@@ -219,53 +219,69 @@ class Unroller {
         }
     }
 
-    // Builds the BVHs of the unions that first hits reach through n.
+    // Builds the BVHs of the unions that first hits reach through n. Operands with an
+    // empty box hold nothing a ray can hit: they are left out.
     void hierarchy(uint32_t n) {
         if (!isUnion(out_.nodes_[n])) return;
         std::vector<uint32_t> items;
         chain_.clear();
         collect(n, Affine::identity(), items);
         for (uint32_t item : items) hierarchy(item);  // unions beyond the chain limit
+        std::erase_if(items, [&](uint32_t i) { return out_.nodes_[i].box.isEmpty(); });
         if (items.size() <= kLeafItems) return;
-        out_.nodes_[n].bvh = split(items, 0, items.size());
+        out_.nodes_[n].bvh = split(items, 0, items.size()).first;
     }
 
-    uint32_t split(std::vector<uint32_t>& items, size_t begin, size_t end) {
-        BvhNode b;
+    // A child of a BVH node: a leaf (count > 0) or a node (count 0), and its box.
+    struct Child {
+        uint32_t first = 0, count = 0;
+        Box box;
+    };
+
+    // The hierarchy over items[begin, end): halves at the median of the items' centres
+    // along the axis where the centres spread widest.
+    Child split(std::vector<uint32_t>& items, size_t begin, size_t end) {
+        Child here;
         Box centres;
         for (size_t k = begin; k < end; ++k) {
             const Box& box = out_.nodes_[items[k]].box;
-            b.box.extend(box);
-            if (!box.isEmpty()) centres.extend(box.center());
+            here.box.extend(box);
+            centres.extend(box.center());
         }
-        const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
-        out_.bvh_.push_back(b);
+        if (end - begin <= kLeafItems) {
+            here.first = static_cast<uint32_t>(out_.items_.size());
+            here.count = static_cast<uint32_t>(end - begin);
+            out_.items_.insert(out_.items_.end(), items.begin() + begin, items.begin() + end);
+            return here;
+        }
         int axis = -1;
         double widest = 0;
-        for (int a = 0; a < 3 && !centres.isEmpty(); ++a) {
+        for (int a = 0; a < 3; ++a) {
             const double w = centres.hi[a] - centres.lo[a];
             if (std::isfinite(w) && w > widest) widest = w, axis = a;
         }
-        if (end - begin <= kLeafItems || axis < 0) {
-            out_.bvh_[index].first = static_cast<uint32_t>(out_.items_.size());
-            out_.bvh_[index].count = static_cast<uint32_t>(end - begin);
-            out_.items_.insert(out_.items_.end(), items.begin() + begin, items.begin() + end);
-            return index;
-        }
         const size_t mid = begin + (end - begin) / 2;
-        // The items' centres along the axis, computed once (indexed by node).
-        if (centres_.size() < out_.nodes_.size()) centres_.resize(out_.nodes_.size());
-        for (size_t k = begin; k < end; ++k) {
-            const Box& box = out_.nodes_[items[k]].box;
-            centres_[items[k]] = box.isEmpty() ? 0.0 : box.center()[axis];
+        if (axis >= 0) {
+            // The items' centres along the axis, computed once (indexed by node).
+            if (centres_.size() < out_.nodes_.size()) centres_.resize(out_.nodes_.size());
+            for (size_t k = begin; k < end; ++k)
+                centres_[items[k]] = out_.nodes_[items[k]].box.center()[axis];
+            std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                             [&](uint32_t a, uint32_t b) { return centres_[a] < centres_[b]; });
         }
-        std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                         [&](uint32_t a, uint32_t b2) { return centres_[a] < centres_[b2]; });
-        const uint32_t left = split(items, begin, mid);
-        const uint32_t right = split(items, mid, end);
-        out_.bvh_[index].left = left;
-        out_.bvh_[index].right = right;
-        return index;
+        here.first = static_cast<uint32_t>(out_.bvh_.size());
+        out_.bvh_.emplace_back();
+        const Child halves[2] = {split(items, begin, mid), split(items, mid, end)};
+        BvhNode& b = out_.bvh_[here.first];
+        for (int c = 0; c < 2; ++c) {
+            for (int a = 0; a < 3; ++a) {
+                b.lo[a][c] = halves[c].box.lo[a];
+                b.hi[a][c] = halves[c].box.hi[a];
+            }
+            b.first[c] = halves[c].first;
+            b.count[c] = halves[c].count;
+        }
+        return here;
     }
 
     void setChoices(Node& x) {
@@ -426,21 +442,80 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         });
 }
 
-bool UnrolledInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
-                                const Use& use, bool anyHit, Scratch& s) const {
-    const BvhNode& bn = bvh_[b];
-    if (bn.left == kNone)
-        return firstOfNodes(items_.data() + bn.first, bn.count, r, tmin, tmax, hit, use, anyHit, s);
-    const uint32_t halves[2] = {bn.left, bn.right};
-    return firstOfUnion(
-        2, tmin, tmax, hit, anyHit, s.order,
-        [&](uint32_t i, double& t0) {
-            double t1 = tmax;
-            return clipToBox(bvh_[halves[i]].box, r, t0, t1);
-        },
-        [&](uint32_t i, double& best, Hit& h) {
-            return firstBvh(halves[i], r, tmin, best, h, use, anyHit, s);
-        });
+namespace {
+
+// Where the ray enters each of a BVH node's two child boxes within [tmin, tmax]
+// (t0[c]), and which it meets at all (bit c of the result). Boxes are only culling
+// here: hits do not depend on them, so the two are tested side by side in SSE2
+// registers, with the same rule as clipToBox for a NaN (it culls nothing).
+int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, double tmin, double tmax,
+                  double t0[2]) {
+    const Vec3& inv = r.inverse();
+#if defined(__SSE2__)
+    if (!r.hasZeroAxis()) {
+        __m128d lo = _mm_set1_pd(tmin), hi = _mm_set1_pd(tmax);
+        for (int a = 0; a < 3; ++a) {
+            const __m128d o = _mm_set1_pd(r.o[a]), iv = _mm_set1_pd(inv[a]);
+            const __m128d x = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(b.lo[a]), o), iv);
+            const __m128d y = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(b.hi[a]), o), iv);
+            lo = _mm_max_pd(_mm_min_pd(y, x), lo);
+            hi = _mm_min_pd(_mm_max_pd(x, y), hi);
+        }
+        _mm_storeu_pd(t0, lo);
+        return _mm_movemask_pd(_mm_cmple_pd(lo, hi));
+    }
+#endif
+    int mask = 0;
+    for (int c = 0; c < 2; ++c) {
+        const Box box{{b.lo[0][c], b.lo[1][c], b.lo[2][c]}, {b.hi[0][c], b.hi[1][c], b.hi[2][c]}};
+        double t1 = tmax;
+        t0[c] = tmin;
+        if (clipToBox(box, r, t0[c], t1)) mask |= 1 << c;
+    }
+    return mask;
+}
+
+}  // namespace
+
+// The first hit in a union's BVH: the nodes front to back by the ray's entry into them
+// (a stack of the ones still to visit, nearer ones on top), each skipped once its entry
+// lies beyond the nearest hit so far.
+bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax,
+                                Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
+    struct Pending {
+        uint32_t first, count;
+        double t0;
+    };
+    // Deeper than any hierarchy of median splits (two entries per level at most).
+    constexpr int kStack = 2 * 32 + 2;
+    Pending stack[kStack];
+    int top = 0;
+    stack[top++] = {root, 0, tmin};
+    bool found = false;
+    while (top > 0) {
+        const Pending p = stack[--top];
+        if (p.t0 > tmax) continue;  // (at tmax exactly it may still win a tie)
+        if (p.count > 0) {
+            if (firstOfNodes(items_.data() + p.first, p.count, r, tmin, tmax, hit, use, anyHit,
+                             s)) {
+                found = true;
+                if (anyHit) return true;
+            }
+            continue;
+        }
+        const BvhNode& b = bvh_[p.first];
+        double t0[2];
+        const int mask = enterChildren(b, r, tmin, tmax, t0);
+        if (mask == 3) {
+            const int nearer = t0[1] < t0[0] ? 1 : 0;
+            stack[top++] = {b.first[1 - nearer], b.count[1 - nearer], t0[1 - nearer]};
+            stack[top++] = {b.first[nearer], b.count[nearer], t0[nearer]};
+        } else if (mask != 0) {
+            const int c = mask - 1;
+            stack[top++] = {b.first[c], b.count[c], t0[c]};
+        }
+    }
+    return found;
 }
 
 size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,

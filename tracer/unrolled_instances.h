@@ -66,10 +66,12 @@ class UnrolledInstance {
     // it (each operand with the matrices on its way, so the arithmetic stays the same) in a
     // bounding-volume hierarchy, because the derivation nests them as the rules do (a
     // flower's 21 petals as a chain 21 unions deep). Spans still follow the derivation.
+    // A node holds the boxes of its two children side by side, so that one SSE2 operation
+    // tests an axis of both; child c is a leaf (count[c] > 0: the operands
+    // items_[first[c], first[c] + count[c])) or another node (count[c] == 0: bvh_[first[c]]).
     struct BvhNode {
-        Box box;
-        uint32_t left = kNone, right = kNone;  // inner nodes
-        uint32_t first = 0, count = 0;         // leaves: operands in items_
+        double lo[3][2], hi[3][2];
+        uint32_t first[2], count[2];
     };
 
     // Where an instance is used: the S-node's instance path, the material above it and the
@@ -101,7 +103,8 @@ class UnrolledInstance {
     // deepest of them stays within max_depth).
     uint32_t levels() const { return levels_; }
     size_t bytes() const;
-    size_t bvhNodes() const { return bvh_.size(); }
+    // The nodes of the first-hit hierarchies, leaves included.
+    size_t bvhNodes() const { return bvh_.empty() ? 0 : 2 * bvh_.size() + 1; }
 
   private:
     friend class Unroller;
@@ -112,7 +115,7 @@ class UnrolledInstance {
                    std::vector<Span>& spans, const Use& use, Scratch& s) const;
     bool firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r, double tmin,
                       double& tmax, Hit& hit, const Use& use, bool anyHit, Scratch& s) const;
-    bool firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+    bool firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax, Hit& hit,
                   const Use& use, bool anyHit, Scratch& s) const;
     LocalRay enter(const Node& node, const LocalRay& r) const;
     Vec3 leave(const Node& node, Vec3 normal) const;
