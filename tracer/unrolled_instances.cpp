@@ -51,11 +51,11 @@ class Unroller {
         if (out_.root_ != kNone) hierarchy(out_.root_);
         out_.nodes_.shrink_to_fit();
         out_.bvh_.shrink_to_fit();
-        out_.items_.shrink_to_fit();
         out_.children_.shrink_to_fit();
         out_.matrices_.shrink_to_fit();
         out_.args_.shrink_to_fit();
         out_.choices_.shrink_to_fit();
+        out_.links_.shrink_to_fit();
     }
 
   private:
@@ -178,82 +178,67 @@ class Unroller {
 
     // Flattening stops where an operand would need more matrices than this on its way.
     static constexpr uint32_t kMaxChain = 12;
-    static constexpr uint32_t kLeafItems = 4;
 
-    // The operands of union u and of the unions nested in it, each as a node entered from
-    // u's frame: an operand below nested unions becomes a copy with their matrices in front
-    // of its own, and its box mapped into u's frame.
-    // The matrices in front of u's own operands are chain_ (a stack shared by the
-    // recursion).
-    void collect(uint32_t u, const Affine& toU, std::vector<uint32_t>& items) {
-        const Node un = out_.nodes_[u];
-        const size_t prefix = chain_.size();
-        for (uint32_t i = 0; i < un.count; ++i) {
-            const uint32_t c = out_.children_[un.first + i];
-            const Node child = out_.nodes_[c];
-            chain_.insert(chain_.end(), out_.matrices_.begin() + child.firstMatrix,
-                          out_.matrices_.begin() + child.firstMatrix + child.matrices);
-            if (isUnion(child) && chain_.size() <= kMaxChain) {
-                Affine to = toU;
-                for (uint32_t k = 0; k < child.matrices; ++k)
-                    to = to * out_.matrices_[child.firstMatrix + k].inverse();
-                collect(c, to, items);
-                chain_.resize(prefix);
-                continue;
-            }
-            if (prefix == 0) {
-                chain_.resize(prefix);
-                items.push_back(c);
-                continue;
-            }
-            Node copy = child;
-            copy.firstMatrix = static_cast<uint32_t>(out_.matrices_.size());
-            copy.matrices = static_cast<uint32_t>(chain_.size());
-            out_.matrices_.insert(out_.matrices_.end(), chain_.begin(), chain_.end());
-            chain_.resize(prefix);
-            copy.box =
-                child.box.isEmpty() ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
-            copy.bvh = kNone;
-            out_.nodes_.push_back(copy);
-            items.push_back(static_cast<uint32_t>(out_.nodes_.size() - 1));
-        }
-    }
-
-    // Builds the BVHs of the unions that first hits reach through n. Operands with an
-    // empty box hold nothing a ray can hit: they are left out.
-    void hierarchy(uint32_t n) {
-        if (!isUnion(out_.nodes_[n])) return;
-        std::vector<uint32_t> items;
-        chain_.clear();
-        collect(n, Affine::identity(), items);
-        for (uint32_t item : items) hierarchy(item);  // unions beyond the chain limit
-        std::erase_if(items, [&](uint32_t i) { return out_.nodes_[i].box.isEmpty(); });
-        if (items.size() <= kLeafItems) return;
-        out_.nodes_[n].bvh = split(items, 0, items.size()).first;
-    }
-
-    // A child of a BVH node: a leaf (count > 0) or a node (count 0), and its box.
-    struct Child {
-        uint32_t first = 0, count = 0;
+    // An operand of a union's BVH: the node, the chain of matrices (links_) from the
+    // union's frame into the frame of the node's own union (kNone: the same frame), and its
+    // box in the union's frame.
+    struct Item {
+        uint32_t node, link;
         Box box;
     };
 
-    // The hierarchy over items[begin, end): halves at the median of the items' centres
-    // along the axis where the centres spread widest.
-    Child split(std::vector<uint32_t>& items, size_t begin, size_t end) {
-        Child here;
+    // The operands of union u and of the unions nested in it, each entered from u's frame
+    // through the chain of matrices of the unions on its way (`link`, a path in the tree
+    // links_ whose branches the operands share), then its own, with its box mapped into u's
+    // frame. `link` (`length` matrices) leads from the outermost union into u's frame
+    // (kNone: u is outermost) and `toU` maps points the other way.
+    void collect(uint32_t u, const Affine& toU, uint32_t link, uint32_t length,
+                 std::vector<Item>& items) {
+        const Node un = out_.nodes_[u];
+        for (uint32_t i = 0; i < un.count; ++i) {
+            const uint32_t c = out_.children_[un.first + i];
+            const Node& child = out_.nodes_[c];
+            if (child.box.isEmpty()) continue;  // holds nothing a ray can hit
+            if (isUnion(child) && length + child.matrices <= kMaxChain) {
+                uint32_t l = link;
+                Affine to = toU;
+                for (uint32_t k = 0; k < child.matrices; ++k) {
+                    l = linkTo(l, child.firstMatrix + k);
+                    to = to * out_.matrices_[child.firstMatrix + k].inverse();
+                }
+                collect(c, to, l, length + child.matrices, items);
+                continue;
+            }
+            const Box box =
+                link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
+            items.push_back({c, link, box});
+        }
+    }
+
+    // The link that applies out_.matrices_[matrix] after the chain `parent`.
+    uint32_t linkTo(uint32_t parent, uint32_t matrix) {
+        const uint64_t key = (static_cast<uint64_t>(parent) << 32) | matrix;
+        const auto [it, added] =
+            linkIndex_.try_emplace(key, static_cast<uint32_t>(out_.links_.size()));
+        if (added) out_.links_.push_back({parent, matrix});
+        return it->second;
+    }
+
+    // Builds the BVHs of the unions that first hits reach through n: one operand per leaf.
+    void hierarchy(uint32_t n) {
+        if (!isUnion(out_.nodes_[n])) return;
+        std::vector<Item> items;
+        collect(n, Affine::identity(), kNone, 0, items);
+        for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
+        if (items.size() < 2) return;
+        out_.nodes_[n].bvh = split(items, 0, items.size());
+    }
+
+    // The hierarchy over items[begin, end) (two or more): halves at the median of the
+    // items' centres along the axis where the centres spread widest. Returns its root.
+    uint32_t split(std::vector<Item>& items, size_t begin, size_t end) {
         Box centres;
-        for (size_t k = begin; k < end; ++k) {
-            const Box& box = out_.nodes_[items[k]].box;
-            here.box.extend(box);
-            centres.extend(box.center());
-        }
-        if (end - begin <= kLeafItems) {
-            here.first = static_cast<uint32_t>(out_.items_.size());
-            here.count = static_cast<uint32_t>(end - begin);
-            out_.items_.insert(out_.items_.end(), items.begin() + begin, items.begin() + end);
-            return here;
-        }
+        for (size_t k = begin; k < end; ++k) centres.extend(items[k].box.center());
         int axis = -1;
         double widest = 0;
         for (int a = 0; a < 3; ++a) {
@@ -261,27 +246,37 @@ class Unroller {
             if (std::isfinite(w) && w > widest) widest = w, axis = a;
         }
         const size_t mid = begin + (end - begin) / 2;
-        if (axis >= 0) {
-            // The items' centres along the axis, computed once (indexed by node).
-            if (centres_.size() < out_.nodes_.size()) centres_.resize(out_.nodes_.size());
-            for (size_t k = begin; k < end; ++k)
-                centres_[items[k]] = out_.nodes_[items[k]].box.center()[axis];
+        // (a box unbounded both ways along the axis has a NaN centre: taken as 0, so that
+        // the order stays strict and weak)
+        auto centre = [axis](const Item& i) {
+            const double c = i.box.center()[axis];
+            return c == c ? c : 0.0;
+        };
+        if (axis >= 0)
             std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                             [&](uint32_t a, uint32_t b) { return centres_[a] < centres_[b]; });
-        }
-        here.first = static_cast<uint32_t>(out_.bvh_.size());
+                             [&](const Item& a, const Item& b) { return centre(a) < centre(b); });
+        const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
         out_.bvh_.emplace_back();
-        const Child halves[2] = {split(items, begin, mid), split(items, mid, end)};
-        BvhNode& b = out_.bvh_[here.first];
+        const size_t bounds[3] = {begin, mid, end};
         for (int c = 0; c < 2; ++c) {
-            for (int a = 0; a < 3; ++a) {
-                b.lo[a][c] = halves[c].box.lo[a];
-                b.hi[a][c] = halves[c].box.hi[a];
+            Box box;
+            for (size_t k = bounds[c]; k < bounds[c + 1]; ++k) box.extend(items[k].box);
+            uint32_t child = 0, link = kNone;
+            if (bounds[c + 1] - bounds[c] == 1) {
+                child = items[bounds[c]].node | UnrolledInstance::kLeaf;
+                link = items[bounds[c]].link;
+            } else {
+                child = split(items, bounds[c], bounds[c + 1]);
             }
-            b.first[c] = halves[c].first;
-            b.count[c] = halves[c].count;
+            BvhNode& b = out_.bvh_[index];
+            for (int a = 0; a < 3; ++a) {
+                b.lo[a][c] = box.lo[a];
+                b.hi[a][c] = box.hi[a];
+            }
+            b.child[c] = child;
+            b.link[c] = link;
         }
-        return here;
+        return index;
     }
 
     void setChoices(Node& x) {
@@ -308,9 +303,8 @@ class Unroller {
     size_t framesUsed_ = 0;
     std::vector<Affine> pending_;
     std::vector<uint32_t> choices_;
-    std::vector<uint32_t> kids_;   // operands of the operators being built
-    std::vector<Affine> chain_;    // collect()'s matrices
-    std::vector<double> centres_;  // split()'s centres, by node
+    std::vector<uint32_t> kids_;                        // operands of the operators being built
+    std::unordered_map<uint64_t, uint32_t> linkIndex_;  // linkTo()'s links by (parent, matrix)
 };
 
 // ---------------------------------------------------------------------------------------
@@ -320,7 +314,7 @@ size_t UnrolledInstance::bytes() const {
     return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
            args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t) +
-           bvh_.capacity() * sizeof(BvhNode) + items_.capacity() * sizeof(uint32_t);
+           bvh_.capacity() * sizeof(BvhNode) + links_.capacity() * sizeof(Link);
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
@@ -338,6 +332,21 @@ Vec3 UnrolledInstance::leave(const Node& node, Vec3 normal) const {
     return normal;
 }
 
+// The ray r (in the frame of the union whose BVH is being walked, at `stamp`) mapped
+// through the chain of matrices of link l, as enter() maps it one matrix after the other:
+// each link's ray is computed once per walk and shared by the copies below it.
+const LocalRay& UnrolledInstance::linkedRay(uint32_t l, const LocalRay& r, uint64_t stamp,
+                                            Scratch& s) const {
+    Scratch::Linked& e = s.linked[l];
+    if (e.stamp == stamp) return e.ray;
+    const Link& link = links_[l];
+    const LocalRay& from = link.parent == kNone ? r : linkedRay(link.parent, r, stamp, s);
+    const Affine& m = matrices_[link.matrix];
+    e.ray = LocalRay{m.point(from.o), m.vector(from.d)};
+    e.stamp = stamp;
+    return e.ray;
+}
+
 uint64_t UnrolledInstance::keyOf(const Node& node, uint64_t path) const {
     for (uint32_t k = 0; k < node.choices; ++k) {
         const uint32_t c = choices_[node.firstChoice + k];
@@ -351,6 +360,7 @@ bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
     if (root_ == kNone) return false;
     double t0 = tmin, t1 = tmax;
     if (!clipToBox(nodes_[root_].box, r, t0, t1)) return false;
+    if (s.linked.size() < links_.size()) s.linked.resize(links_.size());
     return firstAt(root_, r, tmin, tmax, hit, use, anyHit, s);
 }
 
@@ -483,36 +493,40 @@ int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, double 
 bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax,
                                 Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
     struct Pending {
-        uint32_t first, count;
+        uint32_t child, link;
         double t0;
     };
     // Deeper than any hierarchy of median splits (two entries per level at most).
     constexpr int kStack = 2 * 32 + 2;
     Pending stack[kStack];
     int top = 0;
-    stack[top++] = {root, 0, tmin};
+    stack[top++] = {root, kNone, tmin};
+    const uint64_t stamp = ++s.stamp;
     bool found = false;
     while (top > 0) {
         const Pending p = stack[--top];
         if (p.t0 > tmax) continue;  // (at tmax exactly it may still win a tie)
-        if (p.count > 0) {
-            if (firstOfNodes(items_.data() + p.first, p.count, r, tmin, tmax, hit, use, anyHit,
-                             s)) {
+        if (p.child & kLeaf) {      // an operand: its box was the child's box
+            const uint32_t n = p.child & ~kLeaf;
+            const LocalRay& rr = p.link == kNone ? r : linkedRay(p.link, r, stamp, s);
+            if (firstAt(n, rr, tmin, tmax, hit, use, anyHit, s)) {
+                for (uint32_t l = p.link; l != kNone; l = links_[l].parent)
+                    hit.normal = matrices_[links_[l].matrix].transposedVector(hit.normal);
                 found = true;
                 if (anyHit) return true;
             }
             continue;
         }
-        const BvhNode& b = bvh_[p.first];
+        const BvhNode& b = bvh_[p.child];
         double t0[2];
         const int mask = enterChildren(b, r, tmin, tmax, t0);
         if (mask == 3) {
             const int nearer = t0[1] < t0[0] ? 1 : 0;
-            stack[top++] = {b.first[1 - nearer], b.count[1 - nearer], t0[1 - nearer]};
-            stack[top++] = {b.first[nearer], b.count[nearer], t0[nearer]};
+            stack[top++] = {b.child[1 - nearer], b.link[1 - nearer], t0[1 - nearer]};
+            stack[top++] = {b.child[nearer], b.link[nearer], t0[nearer]};
         } else if (mask != 0) {
             const int c = mask - 1;
-            stack[top++] = {b.first[c], b.count[c], t0[c]};
+            stack[top++] = {b.child[c], b.link[c], t0[c]};
         }
     }
     return found;
