@@ -178,6 +178,8 @@ class Unroller {
 
     // Flattening stops where an operand would need more matrices than this on its way.
     static constexpr uint32_t kMaxChain = 12;
+    // Unions of this many operands (after flattening) or fewer get no BVH.
+    static constexpr size_t kFewItems = 4;
 
     // An operand of a union's BVH: the node, the chain of matrices (links_) from the
     // union's frame into the frame of the node's own union (kNone: the same frame), and its
@@ -230,7 +232,7 @@ class Unroller {
         std::vector<Item> items;
         collect(n, Affine::identity(), kNone, 0, items);
         for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
-        if (items.size() < 2) return;
+        if (items.size() <= kFewItems) return;                // the union's own operands will do
         out_.nodes_[n].bvh = split(items, 0, items.size());
     }
 
