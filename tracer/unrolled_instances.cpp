@@ -53,12 +53,12 @@ class Unroller {
         if (out_.root_ != kNone) hierarchy(out_.root_);
         out_.nodes_.shrink_to_fit();
         out_.bvh_.shrink_to_fit();
-        out_.items_.shrink_to_fit();
         out_.children_.shrink_to_fit();
         out_.matrices_.shrink_to_fit();
         out_.matrixRefs_.shrink_to_fit();
         out_.args_.shrink_to_fit();
         out_.choices_.shrink_to_fit();
+        out_.links_.shrink_to_fit();
     }
 
   private:
@@ -198,93 +198,106 @@ class Unroller {
 
     // Flattening stops where an operand would need more matrices than this on its way.
     static constexpr uint32_t kMaxChain = 12;
-    static constexpr uint32_t kLeafItems = 4;
+    // Unions of this many operands (after flattening) or fewer get no BVH.
+    static constexpr size_t kFewItems = 4;
 
-    // The operands of union u and of the unions nested in it, each as a node entered from
-    // u's frame: an operand below nested unions becomes a copy with their matrices in front
-    // of its own, and its box mapped into u's frame.
-    // The matrices in front of u's own operands are chain_ (a stack shared by the
-    // recursion).
-    void collect(uint32_t u, const Affine& toU, std::vector<uint32_t>& items) {
+    // An operand of a union's BVH: the node, the chain of matrices (links_) from the
+    // union's frame into the frame of the node's own union (kNone: the same frame), and its
+    // box in the union's frame.
+    struct Item {
+        uint32_t node, link;
+        Box box;
+    };
+
+    // The operands of union u and of the unions nested in it, each entered from u's frame
+    // through the chain of matrices of the unions on its way (`link`, a path in the tree
+    // links_ whose branches the operands share), then its own, with its box mapped into u's
+    // frame. `link` (`length` matrices) leads from the outermost union into u's frame
+    // (kNone: u is outermost) and `toU` maps points the other way.
+    void collect(uint32_t u, const Affine& toU, uint32_t link, uint32_t length,
+                 std::vector<Item>& items) {
         const Node un = out_.nodes_[u];
-        const size_t prefix = chain_.size();
         for (uint32_t i = 0; i < un.count; ++i) {
             const uint32_t c = out_.children_[un.first + i];
-            const Node child = out_.nodes_[c];
-            chain_.insert(chain_.end(), out_.matrixRefs_.begin() + child.firstMatrix,
-                          out_.matrixRefs_.begin() + child.firstMatrix + child.matrices);
-            if (isUnion(child) && chain_.size() <= kMaxChain) {
+            const Node& child = out_.nodes_[c];
+            if (child.box.isEmpty()) continue;  // holds nothing a ray can hit
+            if (isUnion(child) && length + child.matrices <= kMaxChain) {
+                uint32_t l = link;
                 Affine to = toU;
-                for (uint32_t k = 0; k < child.matrices; ++k)
+                for (uint32_t k = 0; k < child.matrices; ++k) {
+                    l = linkTo(l, out_.matrixRefs_[child.firstMatrix + k]);
                     to = to * out_.matrices_[out_.matrixRefs_[child.firstMatrix + k]].inverse();
-                collect(c, to, items);
-                chain_.resize(prefix);
+                }
+                collect(c, to, l, length + child.matrices, items);
                 continue;
             }
-            if (prefix == 0) {
-                chain_.resize(prefix);
-                items.push_back(c);
-                continue;
-            }
-            Node copy = child;
-            copy.firstMatrix = static_cast<uint32_t>(out_.matrixRefs_.size());
-            copy.matrices = static_cast<uint32_t>(chain_.size());
-            out_.matrixRefs_.insert(out_.matrixRefs_.end(), chain_.begin(), chain_.end());
-            chain_.resize(prefix);
-            copy.box =
-                child.box.isEmpty() ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
-            copy.bvh = kNone;
-            out_.nodes_.push_back(copy);
-            items.push_back(static_cast<uint32_t>(out_.nodes_.size() - 1));
+            const Box box =
+                link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
+            items.push_back({c, link, box});
         }
     }
 
-    // Builds the BVHs of the unions that first hits reach through n.
+    // The link that applies out_.matrices_[matrix] after the chain `parent`.
+    uint32_t linkTo(uint32_t parent, uint32_t matrix) {
+        const uint64_t key = (static_cast<uint64_t>(parent) << 32) | matrix;
+        const auto [it, added] =
+            linkIndex_.try_emplace(key, static_cast<uint32_t>(out_.links_.size()));
+        if (added) out_.links_.push_back({parent, matrix});
+        return it->second;
+    }
+
+    // Builds the BVHs of the unions that first hits reach through n: one operand per leaf.
     void hierarchy(uint32_t n) {
         if (!isUnion(out_.nodes_[n])) return;
-        std::vector<uint32_t> items;
-        chain_.clear();
-        collect(n, Affine::identity(), items);
-        for (uint32_t item : items) hierarchy(item);  // unions beyond the chain limit
-        if (items.size() <= kLeafItems) return;
+        std::vector<Item> items;
+        collect(n, Affine::identity(), kNone, 0, items);
+        for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
+        if (items.size() <= kFewItems) return;                // the union's own operands will do
         out_.nodes_[n].bvh = split(items, 0, items.size());
     }
 
-    uint32_t split(std::vector<uint32_t>& items, size_t begin, size_t end) {
-        BvhNode b;
+    // The hierarchy over items[begin, end) (two or more): halves at the median of the
+    // items' centres along the axis where the centres spread widest. Returns its root.
+    uint32_t split(std::vector<Item>& items, size_t begin, size_t end) {
         Box centres;
-        for (size_t k = begin; k < end; ++k) {
-            const Box& box = out_.nodes_[items[k]].box;
-            b.box.extend(box);
-            if (!box.isEmpty()) centres.extend(box.center());
-        }
-        const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
-        out_.bvh_.push_back(b);
+        for (size_t k = begin; k < end; ++k) centres.extend(items[k].box.center());
         int axis = -1;
         double widest = 0;
-        for (int a = 0; a < 3 && !centres.isEmpty(); ++a) {
+        for (int a = 0; a < 3; ++a) {
             const double w = centres.hi[a] - centres.lo[a];
             if (std::isfinite(w) && w > widest) widest = w, axis = a;
         }
-        if (end - begin <= kLeafItems || axis < 0) {
-            out_.bvh_[index].first = static_cast<uint32_t>(out_.items_.size());
-            out_.bvh_[index].count = static_cast<uint32_t>(end - begin);
-            out_.items_.insert(out_.items_.end(), items.begin() + begin, items.begin() + end);
-            return index;
-        }
         const size_t mid = begin + (end - begin) / 2;
-        // The items' centres along the axis, computed once (indexed by node).
-        if (centres_.size() < out_.nodes_.size()) centres_.resize(out_.nodes_.size());
-        for (size_t k = begin; k < end; ++k) {
-            const Box& box = out_.nodes_[items[k]].box;
-            centres_[items[k]] = box.isEmpty() ? 0.0 : box.center()[axis];
+        // (a box unbounded both ways along the axis has a NaN centre: taken as 0, so that
+        // the order stays strict and weak)
+        auto centre = [axis](const Item& i) {
+            const double c = i.box.center()[axis];
+            return c == c ? c : 0.0;
+        };
+        if (axis >= 0)
+            std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                             [&](const Item& a, const Item& b) { return centre(a) < centre(b); });
+        const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
+        out_.bvh_.emplace_back();
+        const size_t bounds[3] = {begin, mid, end};
+        for (int c = 0; c < 2; ++c) {
+            Box box;
+            for (size_t k = bounds[c]; k < bounds[c + 1]; ++k) box.extend(items[k].box);
+            uint32_t child = 0, link = kNone;
+            if (bounds[c + 1] - bounds[c] == 1) {
+                child = items[bounds[c]].node | UnrolledInstance::kLeaf;
+                link = items[bounds[c]].link;
+            } else {
+                child = split(items, bounds[c], bounds[c + 1]);
+            }
+            BvhNode& b = out_.bvh_[index];
+            for (int a = 0; a < 3; ++a) {
+                b.lo[a][c] = box.lo[a];
+                b.hi[a][c] = box.hi[a];
+            }
+            b.child[c] = child;
+            b.link[c] = link;
         }
-        std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                         [&](uint32_t a, uint32_t b2) { return centres_[a] < centres_[b2]; });
-        const uint32_t left = split(items, begin, mid);
-        const uint32_t right = split(items, mid, end);
-        out_.bvh_[index].left = left;
-        out_.bvh_[index].right = right;
         return index;
     }
 
@@ -313,9 +326,8 @@ class Unroller {
     std::vector<uint32_t> pending_;                       // matrices (indices in out_.matrices_)
     std::unordered_map<uint64_t, uint32_t> matrixIndex_;  // by the bits' hash
     std::vector<uint32_t> choices_;
-    std::vector<uint32_t> kids_;   // operands of the operators being built
-    std::vector<uint32_t> chain_;  // collect()'s matrices (indices)
-    std::vector<double> centres_;  // split()'s centres, by node
+    std::vector<uint32_t> kids_;                        // operands of the operators being built
+    std::unordered_map<uint64_t, uint32_t> linkIndex_;  // linkTo()'s links by (parent, matrix)
 };
 
 // ---------------------------------------------------------------------------------------
@@ -324,9 +336,8 @@ class Unroller {
 size_t UnrolledInstance::bytes() const {
     return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
-           matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) +
-           choices_.capacity() * sizeof(uint32_t) + bvh_.capacity() * sizeof(BvhNode) +
-           items_.capacity() * sizeof(uint32_t);
+           matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t) +
+           bvh_.capacity() * sizeof(BvhNode) + links_.capacity() * sizeof(Link);
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
@@ -344,6 +355,21 @@ Vec3 UnrolledInstance::leave(const Node& node, Vec3 normal) const {
     return normal;
 }
 
+// The ray r (in the frame of the union whose BVH is being walked, at `stamp`) mapped
+// through the chain of matrices of link l, as enter() maps it one matrix after the other:
+// each link's ray is computed once per walk and shared by the copies below it.
+const LocalRay& UnrolledInstance::linkedRay(uint32_t l, const LocalRay& r, uint64_t stamp,
+                                            Scratch& s) const {
+    Scratch::Linked& e = s.linked[l];
+    if (e.stamp == stamp) return e.ray;
+    const Link& link = links_[l];
+    const LocalRay& from = link.parent == kNone ? r : linkedRay(link.parent, r, stamp, s);
+    const Affine& m = matrices_[link.matrix];
+    e.ray = LocalRay{m.point(from.o), m.vector(from.d)};
+    e.stamp = stamp;
+    return e.ray;
+}
+
 uint64_t UnrolledInstance::keyOf(const Node& node, uint64_t path) const {
     for (uint32_t k = 0; k < node.choices; ++k) {
         const uint32_t c = choices_[node.firstChoice + k];
@@ -357,6 +383,7 @@ bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
     if (root_ == kNone) return false;
     double t0 = tmin, t1 = tmax;
     if (!clipToBox(nodes_[root_].box, r, t0, t1)) return false;
+    if (s.linked.size() < links_.size()) s.linked.resize(links_.size());
     return firstAt(root_, r, tmin, tmax, hit, use, anyHit, s);
 }
 
@@ -448,21 +475,84 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         });
 }
 
-bool UnrolledInstance::firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
-                                const Use& use, bool anyHit, Scratch& s) const {
-    const BvhNode& bn = bvh_[b];
-    if (bn.left == kNone)
-        return firstOfNodes(items_.data() + bn.first, bn.count, r, tmin, tmax, hit, use, anyHit, s);
-    const uint32_t halves[2] = {bn.left, bn.right};
-    return firstOfUnion(
-        2, tmin, tmax, hit, anyHit, s.order,
-        [&](uint32_t i, double& t0) {
-            double t1 = tmax;
-            return clipToBox(bvh_[halves[i]].box, r, t0, t1);
-        },
-        [&](uint32_t i, double& best, Hit& h) {
-            return firstBvh(halves[i], r, tmin, best, h, use, anyHit, s);
-        });
+namespace {
+
+// Where the ray enters each of a BVH node's two child boxes within [tmin, tmax]
+// (t0[c]), and which it meets at all (bit c of the result). Boxes are only culling
+// here: hits do not depend on them, so the two are tested side by side in SSE2
+// registers, with the same rule as clipToBox for a NaN (it culls nothing).
+int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, double tmin, double tmax,
+                  double t0[2]) {
+    const Vec3& inv = r.inverse();
+#if defined(__SSE2__)
+    if (!r.hasZeroAxis()) {
+        __m128d lo = _mm_set1_pd(tmin), hi = _mm_set1_pd(tmax);
+        for (int a = 0; a < 3; ++a) {
+            const __m128d o = _mm_set1_pd(r.o[a]), iv = _mm_set1_pd(inv[a]);
+            const __m128d x = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(b.lo[a]), o), iv);
+            const __m128d y = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(b.hi[a]), o), iv);
+            lo = _mm_max_pd(_mm_min_pd(y, x), lo);
+            hi = _mm_min_pd(_mm_max_pd(x, y), hi);
+        }
+        _mm_storeu_pd(t0, lo);
+        return _mm_movemask_pd(_mm_cmple_pd(lo, hi));
+    }
+#endif
+    int mask = 0;
+    for (int c = 0; c < 2; ++c) {
+        const Box box{{b.lo[0][c], b.lo[1][c], b.lo[2][c]}, {b.hi[0][c], b.hi[1][c], b.hi[2][c]}};
+        double t1 = tmax;
+        t0[c] = tmin;
+        if (clipToBox(box, r, t0[c], t1)) mask |= 1 << c;
+    }
+    return mask;
+}
+
+}  // namespace
+
+// The first hit in a union's BVH: the nodes front to back by the ray's entry into them
+// (a stack of the ones still to visit, nearer ones on top), each skipped once its entry
+// lies beyond the nearest hit so far.
+bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax,
+                                Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
+    struct Pending {
+        uint32_t child, link;
+        double t0;
+    };
+    // Deeper than any hierarchy of median splits (two entries per level at most).
+    constexpr int kStack = 2 * 32 + 2;
+    Pending stack[kStack];
+    int top = 0;
+    stack[top++] = {root, kNone, tmin};
+    const uint64_t stamp = ++s.stamp;
+    bool found = false;
+    while (top > 0) {
+        const Pending p = stack[--top];
+        if (p.t0 > tmax) continue;  // (at tmax exactly it may still win a tie)
+        if (p.child & kLeaf) {      // an operand: its box was the child's box
+            const uint32_t n = p.child & ~kLeaf;
+            const LocalRay& rr = p.link == kNone ? r : linkedRay(p.link, r, stamp, s);
+            if (firstAt(n, rr, tmin, tmax, hit, use, anyHit, s)) {
+                for (uint32_t l = p.link; l != kNone; l = links_[l].parent)
+                    hit.normal = matrices_[links_[l].matrix].transposedVector(hit.normal);
+                found = true;
+                if (anyHit) return true;
+            }
+            continue;
+        }
+        const BvhNode& b = bvh_[p.child];
+        double t0[2];
+        const int mask = enterChildren(b, r, tmin, tmax, t0);
+        if (mask == 3) {
+            const int nearer = t0[1] < t0[0] ? 1 : 0;
+            stack[top++] = {b.child[1 - nearer], b.link[1 - nearer], t0[1 - nearer]};
+            stack[top++] = {b.child[nearer], b.link[nearer], t0[nearer]};
+        } else if (mask != 0) {
+            const int c = mask - 1;
+            stack[top++] = {b.child[c], b.link[c], t0[c]};
+        }
+    }
+    return found;
 }
 
 size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,

@@ -66,10 +66,14 @@ class UnrolledInstance {
     // it (each operand with the matrices on its way, so the arithmetic stays the same) in a
     // bounding-volume hierarchy, because the derivation nests them as the rules do (a
     // flower's 21 petals as a chain 21 unions deep). Spans still follow the derivation.
+    // A node holds the boxes of its two children side by side, so that one SSE2 operation
+    // tests an axis of both; child c is another node (bvh_[child[c]]) or, with kLeaf set,
+    // an operand (nodes_[child[c] & ~kLeaf]) entered through the chain of matrices link[c]
+    // (links_; kNone: none) and then its own.
+    static constexpr uint32_t kLeaf = 1u << 31;
     struct BvhNode {
-        Box box;
-        uint32_t left = kNone, right = kNone;  // inner nodes
-        uint32_t first = 0, count = 0;         // leaves: operands in items_
+        double lo[3][2], hi[3][2];
+        uint32_t child[2], link[2];
     };
 
     // Where an instance is used: the S-node's instance path, the material above it and the
@@ -80,10 +84,23 @@ class UnrolledInstance {
         uint32_t paint;
     };
 
-    // Scratch space of one thread (stacks of the walk).
+    // A step of the chains of matrices of BVH operands: links_[parent]'s chain, then
+    // matrices_[matrix] (parent kNone: the chain starts at the union).
+    struct Link {
+        uint32_t parent, matrix;
+    };
+
+    // Scratch space of one thread (stacks of the walk; the ray of each link, valid in the
+    // walk of one BVH, the one with its stamp).
     struct Scratch {
         std::vector<std::pair<double, uint32_t>> order;
         std::vector<Span> spans;
+        struct Linked {
+            uint64_t stamp = 0;
+            LocalRay ray{{}, {}};
+        };
+        std::vector<Linked> linked;
+        uint64_t stamp = 0;
         uint64_t visits = 0;
     };
 
@@ -109,7 +126,8 @@ class UnrolledInstance {
     // deepest of them stays within max_depth).
     uint32_t levels() const { return levels_; }
     size_t bytes() const;
-    size_t bvhNodes() const { return bvh_.size(); }
+    // The nodes of the first-hit hierarchies, leaves included.
+    size_t bvhNodes() const { return bvh_.empty() ? 0 : 2 * bvh_.size() + 1; }
 
   private:
     friend class Unroller;
@@ -120,7 +138,8 @@ class UnrolledInstance {
                    std::vector<Span>& spans, const Use& use, Scratch& s) const;
     bool firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r, double tmin,
                       double& tmax, Hit& hit, const Use& use, bool anyHit, Scratch& s) const;
-    bool firstBvh(uint32_t b, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+    const LocalRay& linkedRay(uint32_t l, const LocalRay& r, uint64_t stamp, Scratch& s) const;
+    bool firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax, Hit& hit,
                   const Use& use, bool anyHit, Scratch& s) const;
     LocalRay enter(const Node& node, const LocalRay& r) const;
     Vec3 leave(const Node& node, Vec3 normal) const;
@@ -133,7 +152,7 @@ class UnrolledInstance {
     std::vector<double> args_;
     std::vector<uint32_t> choices_;  // bit 31: a rule of an S-node, else an operand
     std::vector<BvhNode> bvh_;
-    std::vector<uint32_t> items_;
+    std::vector<Link> links_;
     uint32_t root_ = kNone;
     uint32_t levels_ = 0;
 };

@@ -89,7 +89,7 @@ Rays rays(int n, uint64_t seed, double spread) {
 
 // Fires the rays twice (the second time through the expanded instances) and compares
 // every hit with the walk of the graph, bit for bit. Returns the expansions made.
-uint64_t compareWithGraphWalk(const char* text, double spread, int minHits = 200) {
+uint64_t compareWithGraphWalk(const char* text, const Rays& r, int minHits) {
     auto c = compile(text);
     EXPECT_TRUE(c->graph);
     if (!c->graph) return 0;
@@ -98,7 +98,6 @@ uint64_t compareWithGraphWalk(const char* text, double spread, int minHits = 200
     plain.expansionBytes = 0;
     TraceScene expanding(g, computeBounds(g), true, eager());
     Tracer a(plain), b(expanding);
-    const Rays r = rays(1500, 7, spread);
     int hits = 0;
     for (int round = 0; round < 2; ++round)
         for (size_t i = 0; i < r.o.size(); ++i) {
@@ -116,6 +115,10 @@ uint64_t compareWithGraphWalk(const char* text, double spread, int minHits = 200
     EXPECT_GT(hits, minHits);
     EXPECT_EQ(a.expansions(), 0u);
     return b.expansions();
+}
+
+uint64_t compareWithGraphWalk(const char* text, double spread, int minHits = 200) {
+    return compareWithGraphWalk(text, rays(1500, 7, spread), minHits);
 }
 
 TEST(ExpandedInstances, PlantsHitTheSameSurfacesBitForBit) {
@@ -136,6 +139,21 @@ TEST(ExpandedInstances, UnpaintedPrimitivesTakeTheMaterialOfTheirUse) {
 
 TEST(ExpandedInstances, SierpinskiHitsTheSameSurfacesBitForBit) {
     EXPECT_GT(compareWithGraphWalk(testing::kSierpinski, 1.0), 0u);
+}
+
+// Rays with zero components in their direction (the BVH's box tests take the careful
+// path): along y, and in the plane x = const.
+TEST(ExpandedInstances, AxisParallelRaysHitTheSameSurfacesBitForBit) {
+    Rays r;
+    for (int i = 0; i < 40; ++i)
+        for (int j = 0; j < 40; ++j) {
+            const double x = -1.2 + i * 0.06, z = -1.2 + j * 0.06;
+            r.o.push_back({x, -6, z});
+            r.d.push_back({0, 1, 0});
+            r.o.push_back({x, -6, z});
+            r.d.push_back(normalize(Vec3{0, 6, 0.3 - z * 0.5}));
+        }
+    EXPECT_GT(compareWithGraphWalk(testing::kSierpinski, r, 400), 0u);
 }
 
 // A flower head: 21 petals as a chain of unions 21 deep, each a rotation further on.
