@@ -39,12 +39,14 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "bounds.h"
 #include "geometry.h"
 #include "graph.h"
 #include "semantics.h"
+#include "subtree_count.h"
 #include "walk.h"
 
 namespace pcsg::tracer {
@@ -118,15 +120,23 @@ class InstanceBoxes {
     // all unrolling the same top instance at once. Their boxes are the numbers the rays'
     // misses would compute. A run-time error stops it quietly (the render meets the error
     // itself), and so does `cancel`. Does not take part in the trials of useAt/unrollAt.
-    void prefill(NodeId start, const std::atomic<bool>* cancel = nullptr) const;
+    // The unrolling counts the expansion on the way (subtree_count.h): returns the counts
+    // of the instances it unrolled, for countExpansion (CountOptions::known), so that the
+    // primitive count need only walk the levels above them; null when there are none.
+    std::shared_ptr<const KnownCounts> prefill(NodeId start,
+                                               const std::atomic<bool>* cancel = nullptr) const;
 
     InstanceBoxStats stats() const;
 
   private:
-    friend class BoxSink;
+    template <class>
+    friend class BoxSinkOf;
     friend class SeedSink;
     struct Seed;
+    class CountingWorker;
     std::vector<Seed> seedsAt(NodeId start, uint32_t depth, uint64_t maxVisits) const;
+    std::vector<Seed> prefillSeeds(NodeId start) const;
+    std::optional<KnownSubtree> unrollCounting(CountingWorker& w, const Seed& sd) const;
     struct Stored {
         Box box;
         uint64_t weight = 0;
