@@ -190,8 +190,14 @@ class BoxSinkOf {
     Result nothing() const { return {}; }
     void visit() { ++visits_; }
 
-    // An S-node instance met inside the one being unrolled.
-    bool lookup(NodeId n, uint32_t, const double* frame, uint64_t path, Result& out) {
+    // An S-node instance met inside the one being unrolled. Where no instance of its
+    // S-node and depth was ever stored, the table is not asked (nor its key computed):
+    // the instances there are small, and most of all those met (a terrain's triangles).
+    bool lookup(NodeId n, uint32_t depth, const double* frame, uint64_t path, Result& out) {
+        if (!boxes_.mayHold(n, depth + 1)) {
+            starts_.push_back({visits_, false, {}});
+            return false;
+        }
         InstanceBoxes::Stored s;
         const InstanceBoxes::Key k = boxes_.keyOf(n, frame, path);
         if (boxes_.find(k, s)) {
@@ -201,17 +207,19 @@ class BoxSinkOf {
             counted_ = false;
             return true;
         }
-        starts_.push_back({visits_, k});
+        starts_.push_back({visits_, true, k});
         return false;
     }
-    void store(NodeId, uint32_t, const double*, uint64_t, Result& r) {
+    void store(NodeId n, uint32_t depth, const double* frame, uint64_t path, Result& r) {
         // Every visit below this S-node, including the ones its stored parts stand for.
-        r.weight = visits_ - starts_.back().visits;
-        const InstanceBoxes::Key k = starts_.back().key;
+        const Open open = starts_.back();
         starts_.pop_back();
+        r.weight = visits_ - open.visits;
         r.box = storable(r.box);
-        if (r.weight >= boxes_.opt_.minWeight)
-            boxes_.insert(k, InstanceBoxes::Stored{r.box, r.weight});
+        if (r.weight < boxes_.opt_.minWeight) return;
+        const InstanceBoxes::Key k = open.keyed ? open.key : boxes_.keyOf(n, frame, path);
+        boxes_.insert(k, InstanceBoxes::Stored{r.box, r.weight});
+        boxes_.held(n, depth + 1);
     }
 
     Result toParent(const Affine& m, const Result& local) const {
@@ -248,6 +256,7 @@ class BoxSinkOf {
     bool counted_ = true;
     struct Open {
         uint64_t visits;  // visits_ when the S-node instance began
+        bool keyed;       // whether `key` was computed
         InstanceBoxes::Key key;
     };
     std::vector<Open> starts_;  // the open S-node instances, innermost last
@@ -289,6 +298,7 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);
     decision_ = std::make_unique<std::atomic<uint8_t>[]>(n);
     expand_ = std::make_unique<std::atomic<uint8_t>[]>(n);
+    stored_ = std::make_unique<std::atomic<uint8_t>[]>(n);
     tried_ = std::make_unique<std::atomic<uint32_t>[]>(n);
     paid_ = std::make_unique<std::atomic<uint32_t>[]>(n);
     minWeight_ = std::make_unique<std::atomic<uint64_t>[]>(n);
@@ -298,6 +308,7 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
         const bool analysed = deps_[i / levels_].analysed;
         decision_[i].store(analysed ? 0 : 2, std::memory_order_relaxed);
         expand_[i].store(0, std::memory_order_relaxed);
+        stored_[i].store(0, std::memory_order_relaxed);
         tried_[i].store(0, std::memory_order_relaxed);
         paid_[i].store(0, std::memory_order_relaxed);
         minWeight_[i].store(UINT64_MAX, std::memory_order_relaxed);
@@ -319,6 +330,19 @@ bool InstanceBoxes::useAt(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return false;
     const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
     return decision_[i].load(std::memory_order_relaxed) != 2;
+}
+
+bool InstanceBoxes::mayHold(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return true;
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    return stored_[i].load(std::memory_order_relaxed) != 0;
+}
+
+void InstanceBoxes::held(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return;
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    if (stored_[i].load(std::memory_order_relaxed) == 0)
+        stored_[i].store(1, std::memory_order_relaxed);
 }
 
 bool InstanceBoxes::unrollAt(NodeId select, uint32_t depth) const {

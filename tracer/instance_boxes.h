@@ -146,6 +146,10 @@ class InstanceBoxes {
     Stored unroll(Worker& w, NodeId select, uint32_t depth, const double* frame,
                   uint64_t path) const;
     bool find(const Key& k, Stored& out) const;
+    // Whether an instance of this S-node at this depth was ever stored (then the table
+    // may hold the one asked for), and the note that one was.
+    bool mayHold(NodeId select, uint32_t depth) const;
+    void held(NodeId select, uint32_t depth) const;
     void insert(const Key& k, const Stored& s) const;
     void record(NodeId select, uint32_t depth, const Stored& s) const;
 
@@ -158,9 +162,9 @@ class InstanceBoxes {
     mutable std::atomic<uint64_t> computed_{0};
 
     // Per (module, depth < levels_): 0 undecided, 1 use exact boxes, 2 static only;
-    // whether to expand; and the trial counters.
+    // whether to expand; whether an instance was ever stored; and the trial counters.
     uint32_t levels_ = 0;
-    mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_, expand_;
+    mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_, expand_, stored_;
     mutable std::unique_ptr<std::atomic<uint32_t>[]> tried_, paid_;
     mutable std::unique_ptr<std::atomic<uint64_t>[]> minWeight_, maxWeight_;
 };
