@@ -59,11 +59,22 @@ inline Box storable(const Box& b) {
 
 class InstanceBoxes::Table {
   public:
+    // 40 bytes: 96 bits of the key (its `a`, never 0, and half of its `b`), 4-byte aligned.
     struct Slot {
-        uint64_t a = 0, b = 0;  // the key; a == 0 && b == 0: empty
+        uint32_t a0 = 0, a1 = 0, b1 = 0;  // a0 == 0 && a1 == 0: empty
         float lo[3], hi[3];
         uint32_t weight = 0;
+
+        bool empty() const { return a0 == 0 && a1 == 0; }
+        bool holds(const Key& k) const {
+            return a0 == static_cast<uint32_t>(k.a) && a1 == static_cast<uint32_t>(k.a >> 32) &&
+                   b1 == static_cast<uint32_t>(k.b >> 32);
+        }
+        // Where its probe begins: bits of `a` above the shard's.
+        size_t home(size_t mask) const { return ((static_cast<size_t>(a1) << 32 | a0) >> 6) & mask; }
     };
+    static_assert(sizeof(Slot) == 40);
+    static size_t home(const Key& k, size_t mask) { return (k.a >> 6) & mask; }
 
     explicit Table(size_t maxBytes) : maxBytes_(maxBytes) {}
 
@@ -72,10 +83,10 @@ class InstanceBoxes::Table {
         tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
         if (s.slots.empty()) return false;
         const size_t mask = s.slots.size() - 1;
-        for (size_t i = k.b & mask;; i = (i + 1) & mask) {
+        for (size_t i = home(k, mask);; i = (i + 1) & mask) {
             const Slot& slot = s.slots[i];
-            if (slot.a == 0 && slot.b == 0) return false;
-            if (slot.a == k.a && slot.b == k.b) {
+            if (slot.empty()) return false;
+            if (slot.holds(k)) {
                 for (int j = 0; j < 3; ++j) {
                     out.box.lo[j] = slot.lo[j];
                     out.box.hi[j] = slot.hi[j];
@@ -91,12 +102,13 @@ class InstanceBoxes::Table {
         tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
         if ((s.count + 1) * 4 > s.slots.size() * 3 && !grow(s)) return;
         const size_t mask = s.slots.size() - 1;
-        for (size_t i = k.b & mask;; i = (i + 1) & mask) {
+        for (size_t i = home(k, mask);; i = (i + 1) & mask) {
             Slot& slot = s.slots[i];
-            if (slot.a == k.a && slot.b == k.b) return;  // another thread was first
-            if (slot.a == 0 && slot.b == 0) {
-                slot.a = k.a;
-                slot.b = k.b;
+            if (slot.holds(k)) return;  // another thread was first
+            if (slot.empty()) {
+                slot.a0 = static_cast<uint32_t>(k.a);
+                slot.a1 = static_cast<uint32_t>(k.a >> 32);
+                slot.b1 = static_cast<uint32_t>(k.b >> 32);
                 for (int j = 0; j < 3; ++j) {  // (exact: the box is storable())
                     slot.lo[j] = static_cast<float>(st.box.lo[j]);
                     slot.hi[j] = static_cast<float>(st.box.hi[j]);
@@ -139,9 +151,9 @@ class InstanceBoxes::Table {
         s.slots.assign(size, Slot{});
         const size_t mask = size - 1;
         for (const Slot& o : old) {
-            if (o.a == 0 && o.b == 0) continue;
-            size_t i = o.b & mask;
-            while (s.slots[i].a != 0 || s.slots[i].b != 0) i = (i + 1) & mask;
+            if (o.empty()) continue;
+            size_t i = o.home(mask);
+            while (!s.slots[i].empty()) i = (i + 1) & mask;
             s.slots[i] = o;
         }
         return true;

@@ -22,7 +22,8 @@
 //    computed again: culling never depends on the cache's history.
 //  - Only instances whose sub-graph took at least `minWeight` node visits to unroll are
 //    stored (smaller ones are cheaper to recompute than to keep); the table stops
-//    growing at `maxBytes`. Keys are 128-bit hashes of the instance.
+//    growing at `maxBytes`. Keys are 128-bit hashes of the instance (the table keeps 96
+//    bits of them: 40 bytes an entry).
 //  - Per (module, depth) the cache watches whether the exact boxes are worth it: when
 //    the first instances at a depth are all small, or all about as large as the static
 //    box there (a contractive system like the Sierpinski tetrahedron, whose static boxes
