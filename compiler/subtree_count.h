@@ -36,8 +36,7 @@ inline SubtreeCount countPrimitive(PrimitiveKind kind, uint32_t argc) {
 template <class Operand>
 SubtreeCount countOperator(CsgOp op, uint32_t n, Operand operand) {
     using subtree_count_detail::addSat;
-    if (csgHoldsNothing(op, n, [&](uint32_t i) { return operand(i).empty; }))
-        return SubtreeCount{};
+    if (csgHoldsNothing(op, n, [&](uint32_t i) { return operand(i).empty; })) return SubtreeCount{};
     SubtreeCount sum;
     uint32_t kept = 0;
     for (uint32_t i = 0; i < n; ++i) {

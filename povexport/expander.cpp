@@ -167,7 +167,7 @@ class CountSink {
     uint64_t maxVisits_;
     const KnownCounts* known_;
     uint64_t visits_ = 0;
-    uint64_t whole_ = 0;             // visits without memo and known counts
+    uint64_t whole_ = 0;            // visits without memo and known counts
     std::vector<uint64_t> opened_;  // whole_ where each open S-node instance began
     // Memoised per (S-node, depth, the values of the slots its sub-graph reads); only
     // modules whose sub-graphs do not depend on the instance path.

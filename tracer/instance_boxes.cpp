@@ -71,7 +71,9 @@ class InstanceBoxes::Table {
                    b1 == static_cast<uint32_t>(k.b >> 32);
         }
         // Where its probe begins: bits of `a` above the shard's.
-        size_t home(size_t mask) const { return ((static_cast<size_t>(a1) << 32 | a0) >> 6) & mask; }
+        size_t home(size_t mask) const {
+            return ((static_cast<size_t>(a1) << 32 | a0) >> 6) & mask;
+        }
     };
     static_assert(sizeof(Slot) == 40);
     static size_t home(const Key& k, size_t mask) { return (k.a >> 6) & mask; }
@@ -256,9 +258,8 @@ class BoxSinkOf {
         Result out;
         out.box = csgBox(op, n, [&](uint32_t i) { return r[i].box; });
         if constexpr (kCounts)
-            out.count = countOperator(op, n, [&](uint32_t i) -> const SubtreeCount& {
-                return r[i].count;
-            });
+            out.count =
+                countOperator(op, n, [&](uint32_t i) -> const SubtreeCount& { return r[i].count; });
         return out;
     }
 
@@ -389,7 +390,6 @@ InstanceBoxes::Key instanceKey(const Graph& g, const std::vector<ModuleDependenc
 InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint64_t path) const {
     return instanceKey(g_, deps_, select, frame, path);
 }
-
 
 bool InstanceBoxes::find(const Key& k, Stored& out) const {
     return table_->find(k, out);
@@ -537,8 +537,7 @@ std::vector<InstanceBoxes::Seed> InstanceBoxes::prefillSeeds(NodeId start) const
 
 // Unrolls a seed as a miss would, counting its expansion on the way: its count, when the
 // walk counted everything below it itself (see BoxSinkOf::counted).
-std::optional<KnownSubtree> InstanceBoxes::unrollCounting(CountingWorker& w,
-                                                          const Seed& sd) const {
+std::optional<KnownSubtree> InstanceBoxes::unrollCounting(CountingWorker& w, const Seed& sd) const {
     computed_.fetch_add(1, std::memory_order_relaxed);
     w.sink.reset();
     WalkStart start;
