@@ -54,7 +54,9 @@ namespace pcsg::tracer {
 
 struct InstanceBoxOptions {
     size_t maxBytes = 64u << 20;  // the table's size limit
-    uint64_t minWeight = 48;      // store instances whose unrolling took this many visits
+    // Store instances whose unrolling took this many visits (the terrain: its instances
+    // of 64 triangles and more; those of 16 are 75% of the entries and paid nothing).
+    uint64_t minWeight = 200;
     // Per (module, depth): decide after this many computed instances whether exact boxes
     // pay there.
     uint32_t trial = 24;
