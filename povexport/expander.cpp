@@ -53,17 +53,7 @@ namespace {
 // ---------------------------------------------------------------------------------------
 // The counting sink.
 
-struct Count {
-    uint64_t prims = 0, nodes = 0, args = 0;
-    bool empty = true;
-};
-
-Count plus(Count a, const Count& b) {
-    a.prims = addSat(a.prims, b.prims);
-    a.nodes = addSat(a.nodes, b.nodes);
-    a.args = addSat(a.args, b.args);
-    return a;
-}
+using Count = SubtreeCount;
 
 struct StopCounting {};
 
@@ -87,8 +77,15 @@ class CountSink {
     using Result = Count;
     static constexpr size_t kMaxMemo = 1 << 18;
 
-    CountSink(const Graph& g, uint64_t maxVisits)
-        : g_(g), maxVisits_(maxVisits), deps_(moduleDependencies(g)), modules_(deps_.size()) {
+    // With `known`, the counts found before are taken where they stand, and the count
+    // stops (complete = false) as soon as the walk without them and without the memo
+    // would have made more than maxVisits visits (see countExpansion).
+    CountSink(const Graph& g, uint64_t maxVisits, const KnownCounts* known)
+        : g_(g),
+          maxVisits_(maxVisits),
+          known_(known),
+          deps_(moduleDependencies(g)),
+          modules_(deps_.size()) {
         for (size_t m = 0; m < deps_.size(); ++m)
             modules_[m].memoisable = deps_[m].analysed && !deps_[m].usesPath;
     }
@@ -98,9 +95,52 @@ class CountSink {
 
     void visit() {
         if (++visits_ > maxVisits_) throw StopCounting{};
+        addWhole(1);
     }
 
-    bool lookup(NodeId n, uint32_t depth, const double* frame, uint64_t, Count& out) {
+    bool lookup(NodeId n, uint32_t depth, const double* frame, uint64_t path, Count& out) {
+        if (known_ && knownBelow(n, depth, frame, path, out)) return true;
+        if (memoised(n, depth, frame, out)) return true;
+        opened_.push_back(whole_);
+        return false;
+    }
+    void store(NodeId n, uint32_t depth, const double* frame, uint64_t, const Count& c) {
+        const uint64_t below = whole_ - opened_.back();
+        opened_.pop_back();
+        if (memo_.size() >= kMaxMemo || !makeKey(n, depth, frame)) return;
+        memo_.emplace(key_, Memo{c, below});
+    }
+
+    Count primitive(PrimitiveKind kind, const Affine&, uint32_t, const double*, uint32_t argc) {
+        return countPrimitive(kind, argc);
+    }
+
+    void beginOperator(WalkEntry&) {}
+
+    Count endOperator(CsgOp op, const Count* r, uint32_t n, const WalkEntry&) {
+        return countOperator(op, n, [&](uint32_t i) -> const Count& { return r[i]; });
+    }
+
+  private:
+    // The visits of the walk without memo and known counts, which stops a count with
+    // known counts at the work limit.
+    void addWhole(uint64_t n) {
+        whole_ = addSat(whole_, n);
+        if (known_ && whole_ > maxVisits_) throw StopCounting{};
+    }
+
+    // An instance counted before (the instance-box fill): its count, without walking
+    // below it.
+    bool knownBelow(NodeId n, uint32_t depth, const double* frame, uint64_t path, Count& out) {
+        KnownSubtree k;
+        if (!known_->find(n, depth, frame, path, k)) return false;
+        addWhole(k.visits);
+        visits_ = addSat(visits_, k.visits);
+        out = k.count;
+        return true;
+    }
+
+    bool memoised(NodeId n, uint32_t depth, const double* frame, Count& out) {
         if (!makeKey(n, depth, frame)) return false;
         ModuleMemo& s = modules_[g_.nodes[n].payload];
         // A module whose parameter frames never repeat (a terrain's coordinates) is not
@@ -109,37 +149,11 @@ class CountSink {
         const auto it = memo_.find(key_);
         if (it == memo_.end()) return false;
         ++s.hits;
-        out = it->second;
+        out = it->second.count;
+        addWhole(it->second.whole);
         return true;
     }
-    void store(NodeId n, uint32_t depth, const double* frame, uint64_t, const Count& c) {
-        if (memo_.size() >= kMaxMemo || !makeKey(n, depth, frame)) return;
-        memo_.emplace(key_, c);
-    }
 
-    Count primitive(PrimitiveKind kind, const Affine&, uint32_t, const double*, uint32_t argc) {
-        if (kind == PrimitiveKind::Empty) return Count{};
-        return Count{1, 1, argc, false};
-    }
-
-    void beginOperator(WalkEntry&) {}
-
-    Count endOperator(CsgOp op, const Count* r, uint32_t n, const WalkEntry&) {
-        Count sum;
-        uint32_t kept = 0;
-        if (csgHoldsNothing(op, n, [&](uint32_t i) { return r[i].empty; })) return Count{};
-        for (uint32_t i = 0; i < n; ++i) {
-            if (r[i].empty) continue;
-            sum = plus(sum, r[i]);
-            ++kept;
-        }
-        if (kept == 0) return Count{};
-        sum.empty = false;
-        if (kept >= 2) sum.nodes = addSat(sum.nodes, 1);
-        return sum;
-    }
-
-  private:
     bool makeKey(NodeId n, uint32_t depth, const double* frame) {
         const uint32_t m = g_.nodes[n].payload;
         if (!modules_[m].memoisable) return false;
@@ -151,7 +165,10 @@ class CountSink {
 
     const Graph& g_;
     uint64_t maxVisits_;
+    const KnownCounts* known_;
     uint64_t visits_ = 0;
+    uint64_t whole_ = 0;            // visits without memo and known counts
+    std::vector<uint64_t> opened_;  // whole_ where each open S-node instance began
     // Memoised per (S-node, depth, the values of the slots its sub-graph reads); only
     // modules whose sub-graphs do not depend on the instance path.
     struct ModuleMemo {
@@ -161,7 +178,11 @@ class CountSink {
     std::vector<ModuleDependencies> deps_;
     std::vector<ModuleMemo> modules_;
     std::vector<uint64_t> key_;
-    std::unordered_map<std::vector<uint64_t>, Count, KeyHash> memo_;
+    struct Memo {
+        Count count;
+        uint64_t whole;  // the visits below without memo
+    };
+    std::unordered_map<std::vector<uint64_t>, Memo, KeyHash> memo_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -257,8 +278,10 @@ std::string countText(uint64_t n) {
 
 // ---------------------------------------------------------------------------------------
 
-ExpansionCount countExpansion(const Graph& g, const CountOptions& options) {
-    CountSink sink(g, options.maxVisits);
+namespace {
+
+ExpansionCount countWith(const Graph& g, uint64_t maxVisits, const KnownCounts* known) {
+    CountSink sink(g, maxVisits, known);
     const Semantics sem(g);
     Walker<CountSink> walker(sem, sink);
     ExpansionCount out;
@@ -273,6 +296,21 @@ ExpansionCount countExpansion(const Graph& g, const CountOptions& options) {
     }
     out.visits = sink.visits();
     return out;
+}
+
+}  // namespace
+
+// With known counts, the count is what the count without them would be: the same
+// figures (memo and known counts are exact) and the same first error (the parts they
+// stand for hold none, and the walk's order is the same), provided the count without
+// them completes too, which it does when the walk without memo stays within the limit
+// (the memo only saves visits). Otherwise it is counted again without them.
+ExpansionCount countExpansion(const Graph& g, const CountOptions& options) {
+    if (options.known) {
+        const ExpansionCount out = countWith(g, options.maxVisits, options.known);
+        if (out.complete) return out;
+    }
+    return countWith(g, options.maxVisits, nullptr);
 }
 
 ExpandedTree expand(const Graph& g, const ExpandOptions& options) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "graph.h"
+#include "subtree_count.h"
 #include "walk.h"
 
 namespace pcsg {
@@ -86,6 +87,9 @@ struct ExpansionCount {
 struct CountOptions {
     // Stop (complete = false) after this many node visits.
     uint64_t maxVisits = UINT64_MAX;
+    // S-node instances counted before (InstanceBoxes::prefill's): their counts are taken
+    // instead of walking below them. Null: everything is walked here.
+    const KnownCounts* known = nullptr;
 };
 
 // Counts the expanded tree without building it. Sub-graphs below an S-node whose

@@ -10,6 +10,9 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <optional>
+#include <type_traits>
+#include <unordered_map>
 
 #include "primitives.h"
 
@@ -57,11 +60,24 @@ inline Box storable(const Box& b) {
 
 class InstanceBoxes::Table {
   public:
+    // 40 bytes: 96 bits of the key (its `a`, never 0, and half of its `b`), 4-byte aligned.
     struct Slot {
-        uint64_t a = 0, b = 0;  // the key; a == 0 && b == 0: empty
+        uint32_t a0 = 0, a1 = 0, b1 = 0;  // a0 == 0 && a1 == 0: empty
         float lo[3], hi[3];
         uint32_t weight = 0;
+
+        bool empty() const { return a0 == 0 && a1 == 0; }
+        bool holds(const Key& k) const {
+            return a0 == static_cast<uint32_t>(k.a) && a1 == static_cast<uint32_t>(k.a >> 32) &&
+                   b1 == static_cast<uint32_t>(k.b >> 32);
+        }
+        // Where its probe begins: bits of `a` above the shard's.
+        size_t home(size_t mask) const {
+            return ((static_cast<size_t>(a1) << 32 | a0) >> 6) & mask;
+        }
     };
+    static_assert(sizeof(Slot) == 40);
+    static size_t home(const Key& k, size_t mask) { return (k.a >> 6) & mask; }
 
     explicit Table(size_t maxBytes) : maxBytes_(maxBytes) {}
 
@@ -70,10 +86,10 @@ class InstanceBoxes::Table {
         tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
         if (s.slots.empty()) return false;
         const size_t mask = s.slots.size() - 1;
-        for (size_t i = k.b & mask;; i = (i + 1) & mask) {
+        for (size_t i = home(k, mask);; i = (i + 1) & mask) {
             const Slot& slot = s.slots[i];
-            if (slot.a == 0 && slot.b == 0) return false;
-            if (slot.a == k.a && slot.b == k.b) {
+            if (slot.empty()) return false;
+            if (slot.holds(k)) {
                 for (int j = 0; j < 3; ++j) {
                     out.box.lo[j] = slot.lo[j];
                     out.box.hi[j] = slot.hi[j];
@@ -89,12 +105,13 @@ class InstanceBoxes::Table {
         tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
         if ((s.count + 1) * 4 > s.slots.size() * 3 && !grow(s)) return;
         const size_t mask = s.slots.size() - 1;
-        for (size_t i = k.b & mask;; i = (i + 1) & mask) {
+        for (size_t i = home(k, mask);; i = (i + 1) & mask) {
             Slot& slot = s.slots[i];
-            if (slot.a == k.a && slot.b == k.b) return;  // another thread was first
-            if (slot.a == 0 && slot.b == 0) {
-                slot.a = k.a;
-                slot.b = k.b;
+            if (slot.holds(k)) return;  // another thread was first
+            if (slot.empty()) {
+                slot.a0 = static_cast<uint32_t>(k.a);
+                slot.a1 = static_cast<uint32_t>(k.a >> 32);
+                slot.b1 = static_cast<uint32_t>(k.b >> 32);
                 for (int j = 0; j < 3; ++j) {  // (exact: the box is storable())
                     slot.lo[j] = static_cast<float>(st.box.lo[j]);
                     slot.hi[j] = static_cast<float>(st.box.hi[j]);
@@ -137,9 +154,9 @@ class InstanceBoxes::Table {
         s.slots.assign(size, Slot{});
         const size_t mask = size - 1;
         for (const Slot& o : old) {
-            if (o.a == 0 && o.b == 0) continue;
-            size_t i = o.b & mask;
-            while (s.slots[i].a != 0 || s.slots[i].b != 0) i = (i + 1) & mask;
+            if (o.empty()) continue;
+            size_t i = o.home(mask);
+            while (!s.slots[i].empty()) i = (i + 1) & mask;
             s.slots[i] = o;
         }
         return true;
@@ -159,51 +176,81 @@ struct BoxResult {
     uint64_t weight = 0;
 };
 
-class BoxSink {
-  public:
-    using Result = BoxResult;
-    static constexpr bool kLocalSelectFrames = true;
+// The same, with the count of the expanded sub-tree (the prefill's: subtree_count.h).
+struct CountedBoxResult {
+    Box box;
+    uint64_t weight = 0;
+    SubtreeCount count;
+};
 
-    explicit BoxSink(const InstanceBoxes& boxes) : boxes_(boxes) {}
+template <class R>
+class BoxSinkOf {
+  public:
+    using Result = R;
+    static constexpr bool kLocalSelectFrames = true;
+    static constexpr bool kCounts = std::is_same_v<R, CountedBoxResult>;
+
+    explicit BoxSinkOf(const InstanceBoxes& boxes) : boxes_(boxes) {}
 
     void reset() {
         visits_ = 0;
         starts_.clear();
+        counted_ = true;
     }
+    // Counting: whether the walk since reset() counted everything below it itself (no
+    // stored box stood for a part): then its count is whole, and its visits are those
+    // of the walk without memo.
+    bool counted() const { return counted_; }
 
     Result nothing() const { return {}; }
     void visit() { ++visits_; }
 
-    // An S-node instance met inside the one being unrolled.
-    bool lookup(NodeId n, uint32_t, const double* frame, uint64_t path, Result& out) {
+    // An S-node instance met inside the one being unrolled. Where no instance of its
+    // S-node and depth was ever stored, the table is not asked (nor its key computed):
+    // the instances there are small, and most of all those met (a terrain's triangles).
+    bool lookup(NodeId n, uint32_t depth, const double* frame, uint64_t path, Result& out) {
+        if (!boxes_.mayHold(n, depth + 1)) {
+            starts_.push_back({visits_, false, {}});
+            return false;
+        }
         InstanceBoxes::Stored s;
         const InstanceBoxes::Key k = boxes_.keyOf(n, frame, path);
         if (boxes_.find(n, k, s)) {
-            out = {s.box, s.weight};
+            out.box = s.box;
+            out.weight = s.weight;
             visits_ += s.weight;  // it stands for that many visits
+            counted_ = false;
             return true;
         }
-        starts_.push_back({visits_, k});
+        starts_.push_back({visits_, true, k});
         return false;
     }
-    void store(NodeId n, uint32_t, const double*, uint64_t, Result& r) {
+    void store(NodeId n, uint32_t depth, const double* frame, uint64_t path, Result& r) {
         // Every visit below this S-node, including the ones its stored parts stand for.
-        r.weight = visits_ - starts_.back().visits;
-        const InstanceBoxes::Key k = starts_.back().key;
+        const Open open = starts_.back();
         starts_.pop_back();
+        r.weight = visits_ - open.visits;
         r.box = storable(r.box);
-        if (r.weight >= boxes_.opt_.minWeight)
-            boxes_.insert(n, k, InstanceBoxes::Stored{r.box, r.weight});
+        if (r.weight < boxes_.opt_.minWeight) return;
+        const InstanceBoxes::Key k = open.keyed ? open.key : boxes_.keyOf(n, frame, path);
+        boxes_.insert(n, k, InstanceBoxes::Stored{r.box, r.weight});
+        boxes_.held(n, depth + 1);
     }
 
     Result toParent(const Affine& m, const Result& local) const {
-        return {transformBox(m, local.box), local.weight};
+        Result r = local;
+        r.box = transformBox(m, local.box);
+        return r;
     }
 
     Result primitive(PrimitiveKind kind, const Affine& world, uint32_t, const double* args,
-                     uint32_t) const {
-        if (kind == PrimitiveKind::Empty) return {};
-        return {transformBox(world, primitiveBox(kind, args)), 1};
+                     uint32_t argc) const {
+        Result r;
+        if constexpr (kCounts) r.count = countPrimitive(kind, argc);
+        if (kind == PrimitiveKind::Empty) return r;
+        r.box = transformBox(world, primitiveBox(kind, args));
+        r.weight = 1;
+        return r;
     }
 
     void beginOperator(WalkEntry&) {}
@@ -211,24 +258,44 @@ class BoxSink {
     Result endOperator(CsgOp op, const Result* r, uint32_t n, const WalkEntry&) const {
         Result out;
         out.box = csgBox(op, n, [&](uint32_t i) { return r[i].box; });
+        if constexpr (kCounts)
+            out.count =
+                countOperator(op, n, [&](uint32_t i) -> const SubtreeCount& { return r[i].count; });
         return out;
     }
 
   private:
     const InstanceBoxes& boxes_;
     uint64_t visits_ = 0;
+    bool counted_ = true;
     struct Open {
         uint64_t visits;  // visits_ when the S-node instance began
+        bool keyed;       // whether `key` was computed
         InstanceBoxes::Key key;
     };
     std::vector<Open> starts_;  // the open S-node instances, innermost last
 };
 
-class InstanceBoxes::Worker {
+using BoxSink = BoxSinkOf<BoxResult>;
+
+template <class Sink>
+struct WorkerOf {
+    explicit WorkerOf(const InstanceBoxes& boxes, const Semantics& sem)
+        : sink(boxes), walker(sem, sink) {}
+    Sink sink;
+    Walker<Sink> walker;
+};
+
+class InstanceBoxes::Worker : public WorkerOf<BoxSink> {
   public:
-    explicit Worker(const InstanceBoxes& boxes) : sink(boxes), walker(boxes.sem_, sink) {}
-    BoxSink sink;
-    Walker<BoxSink> walker;
+    explicit Worker(const InstanceBoxes& boxes) : WorkerOf<BoxSink>(boxes, boxes.sem_) {}
+};
+
+// The prefill's: counts what it unrolls (InstanceBoxes::prefill).
+class InstanceBoxes::CountingWorker : public WorkerOf<BoxSinkOf<CountedBoxResult>> {
+  public:
+    explicit CountingWorker(const InstanceBoxes& boxes)
+        : WorkerOf<BoxSinkOf<CountedBoxResult>>(boxes, boxes.sem_) {}
 };
 
 // ---------------------------------------------------------------------------------------
@@ -251,6 +318,7 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);
     decision_ = std::make_unique<std::atomic<uint8_t>[]>(n);
     expand_ = std::make_unique<std::atomic<uint8_t>[]>(n);
+    stored_ = std::make_unique<std::atomic<uint8_t>[]>(n);
     tried_ = std::make_unique<std::atomic<uint32_t>[]>(n);
     paid_ = std::make_unique<std::atomic<uint32_t>[]>(n);
     minWeight_ = std::make_unique<std::atomic<uint64_t>[]>(n);
@@ -260,6 +328,7 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
         const bool analysed = deps_[i / levels_].analysed;
         decision_[i].store(analysed ? 0 : 2, std::memory_order_relaxed);
         expand_[i].store(0, std::memory_order_relaxed);
+        stored_[i].store(0, std::memory_order_relaxed);
         tried_[i].store(0, std::memory_order_relaxed);
         paid_[i].store(0, std::memory_order_relaxed);
         minWeight_[i].store(UINT64_MAX, std::memory_order_relaxed);
@@ -283,6 +352,19 @@ bool InstanceBoxes::useAt(NodeId select, uint32_t depth) const {
     return decision_[i].load(std::memory_order_relaxed) != 2;
 }
 
+bool InstanceBoxes::mayHold(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return true;
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    return stored_[i].load(std::memory_order_relaxed) != 0;
+}
+
+void InstanceBoxes::held(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return;
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    if (stored_[i].load(std::memory_order_relaxed) == 0)
+        stored_[i].store(1, std::memory_order_relaxed);
+}
+
 bool InstanceBoxes::unrollAt(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return false;
     const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
@@ -292,10 +374,12 @@ bool InstanceBoxes::unrollAt(NodeId select, uint32_t depth) const {
 // Two lanes of xxHash64's round (acc = rotl(acc + v * P2, 31) * P1), each with its own
 // constants, finished with SplitMix64's finaliser: one multiplication per value on each
 // lane's dependency chain, where a full finaliser per value took three.
-InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint64_t path) const {
+namespace {
+InstanceBoxes::Key instanceKey(const Graph& g, const std::vector<ModuleDependencies>& deps,
+                               NodeId select, const double* frame, uint64_t path) {
     constexpr uint64_t P1 = 0x9e3779b185ebca87ULL, P2 = 0xc2b2ae3d27d4eb4fULL;
     constexpr uint64_t P3 = 0x165667b19e3779f9ULL, P4 = 0x85ebca77c2b2ae63ULL;
-    const ModuleDependencies& d = deps_[g_.nodes[select].payload];
+    const ModuleDependencies& d = deps[g.nodes[select].payload];
     uint64_t a = 0x84222325cbf29ce4ULL ^ (select * P1), b = 0x2545f4914f6cdd1dULL + select * P3;
     auto round = [&](uint64_t v) {
         a = std::rotl(a + v * P2, 31) * P1;
@@ -307,6 +391,11 @@ InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint
     a = mix(a ^ n);
     b = mix(b ^ std::rotl(a, 32));
     return {a | 1, b};  // a != 0: never the empty slot
+}
+}  // namespace
+
+InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint64_t path) const {
+    return instanceKey(g_, deps_, select, frame, path);
 }
 
 InstanceBoxes::Table& InstanceBoxes::tableOf(NodeId select) const {
@@ -442,9 +531,9 @@ std::vector<InstanceBoxes::Seed> InstanceBoxes::seedsAt(NodeId start, uint32_t d
     return std::move(sink.seeds);
 }
 
-void InstanceBoxes::prefill(NodeId start, const std::atomic<bool>* cancel) const {
-    // Enough instances to share out among the threads, found by a walk of the levels
-    // above them (a few thousand visits at most).
+// The instances to fill ahead: enough to share out among the threads, found by a walk of
+// the levels above them (a few thousand visits at most).
+std::vector<InstanceBoxes::Seed> InstanceBoxes::prefillSeeds(NodeId start) const {
     constexpr size_t kEnough = 64;
     constexpr uint64_t kMaxVisits = 1u << 20;
     std::vector<Seed> seeds;
@@ -453,13 +542,69 @@ void InstanceBoxes::prefill(NodeId start, const std::atomic<bool>* cancel) const
         if (deeper.size() <= seeds.size()) break;
         seeds = std::move(deeper);
     }
-    if (seeds.size() < 2) return;
-    tbb::enumerable_thread_specific<WorkerPtr> workers([this] { return makeWorker(); });
+    return seeds;
+}
+
+// Unrolls a seed as a miss would, counting its expansion on the way: its count, when the
+// walk counted everything below it itself (see BoxSinkOf::counted).
+std::optional<KnownSubtree> InstanceBoxes::unrollCounting(CountingWorker& w, const Seed& sd) const {
+    computed_.fetch_add(1, std::memory_order_relaxed);
+    w.sink.reset();
+    WalkStart start;
+    start.node = sd.node;
+    start.frame = sd.frame.data();
+    start.path = sd.path;
+    start.depth = sd.depth > 0 ? sd.depth - 1 : 0;  // the walk counts this S-node itself
+    const CountedBoxResult r = w.walker.run(start, /*annotateStart=*/false);
+    if (!w.sink.counted() || sd.depth == 0) return std::nullopt;
+    return KnownSubtree{r.count, r.weight};
+}
+
+namespace {
+
+// The counts of the instances the prefill unrolled, for the primitive count (a
+// KnownCounts for countExpansion): found by their keys, at the one depth of the seeds.
+class PrefillCounts : public KnownCounts {
+  public:
+    PrefillCounts(const Graph& g, std::vector<ModuleDependencies> deps, uint32_t depth)
+        : g_(g), deps_(std::move(deps)), depth_(depth) {}
+
+    void add(const InstanceBoxes::Key& k, const KnownSubtree& s) { known_.emplace(k, s); }
+    bool empty() const { return known_.empty(); }
+
+    bool find(NodeId select, uint32_t depth, const double* frame, uint64_t path,
+              KnownSubtree& out) const override {
+        if (depth + 1 != depth_) return false;
+        const auto it = known_.find(instanceKey(g_, deps_, select, frame, path));
+        if (it == known_.end()) return false;
+        out = it->second;
+        return true;
+    }
+
+  private:
+    struct KeyHash {
+        size_t operator()(const InstanceBoxes::Key& k) const { return static_cast<size_t>(k.b); }
+    };
+    const Graph& g_;
+    const std::vector<ModuleDependencies> deps_;
+    const uint32_t depth_;  // the seeds' (S-nodes passed, this one included)
+    std::unordered_map<InstanceBoxes::Key, KnownSubtree, KeyHash> known_;
+};
+
+}  // namespace
+
+std::shared_ptr<const KnownCounts> InstanceBoxes::prefill(NodeId start,
+                                                          const std::atomic<bool>* cancel) const {
+    const std::vector<Seed> seeds = prefillSeeds(start);
+    if (seeds.size() < 2) return nullptr;
+    std::vector<std::optional<KnownSubtree>> counted(seeds.size());
+    tbb::enumerable_thread_specific<std::unique_ptr<CountingWorker>> workers(
+        [this] { return std::make_unique<CountingWorker>(*this); });
     std::atomic<bool> stop{false};
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, seeds.size(), 1),
         [&](const tbb::blocked_range<size_t>& range) {
-            Worker& w = *workers.local();
+            CountingWorker& w = *workers.local();
             for (size_t i = range.begin(); i != range.end(); ++i) {
                 if (stop.load(std::memory_order_relaxed) ||
                     (cancel && cancel->load(std::memory_order_relaxed)))
@@ -468,13 +613,19 @@ void InstanceBoxes::prefill(NodeId start, const std::atomic<bool>* cancel) const
                 Stored s;
                 if (find(sd.node, keyOf(sd.node, sd.frame.data(), sd.path), s)) continue;
                 try {
-                    unroll(w, sd.node, sd.depth, sd.frame.data(), sd.path);
+                    counted[i] = unrollCounting(w, sd);
                 } catch (const RuntimeError&) {
                     stop = true;
                 }
             }
         },
         tbb::simple_partitioner());
+    auto known = std::make_shared<PrefillCounts>(g_, deps_, seeds.front().depth);
+    for (size_t i = 0; i < seeds.size(); ++i)
+        if (counted[i] && seeds[i].depth == seeds.front().depth)
+            known->add(keyOf(seeds[i].node, seeds[i].frame.data(), seeds[i].path), *counted[i]);
+    if (known->empty()) return nullptr;
+    return known;
 }
 
 // With a sequence's table: its entries too (what this frame could find).

@@ -22,7 +22,8 @@
 //    computed again: culling never depends on the cache's history.
 //  - Only instances whose sub-graph took at least `minWeight` node visits to unroll are
 //    stored (smaller ones are cheaper to recompute than to keep); the table stops
-//    growing at `maxBytes`. Keys are 128-bit hashes of the instance.
+//    growing at `maxBytes`. Keys are 128-bit hashes of the instance (the table keeps 96
+//    bits of them: 40 bytes an entry).
 //  - Per (module, depth) the cache watches whether the exact boxes are worth it: when
 //    the first instances at a depth are all small, or all about as large as the static
 //    box there (a contractive system like the Sierpinski tetrahedron, whose static boxes
@@ -39,12 +40,14 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "bounds.h"
 #include "geometry.h"
 #include "graph.h"
 #include "semantics.h"
+#include "subtree_count.h"
 #include "walk.h"
 
 namespace pcsg::tracer {
@@ -53,7 +56,9 @@ class SequenceInstanceBoxes;
 
 struct InstanceBoxOptions {
     size_t maxBytes = 64u << 20;  // the table's size limit
-    uint64_t minWeight = 48;      // store instances whose unrolling took this many visits
+    // Store instances whose unrolling took this many visits (the terrain: its instances
+    // of 64 triangles and more; those of 16 are 75% of the entries and paid nothing).
+    uint64_t minWeight = 200;
     // Per (module, depth): decide after this many computed instances whether exact boxes
     // pay there.
     uint32_t trial = 24;
@@ -123,16 +128,24 @@ class InstanceBoxes {
     // all unrolling the same top instance at once. Their boxes are the numbers the rays'
     // misses would compute. A run-time error stops it quietly (the render meets the error
     // itself), and so does `cancel`. Does not take part in the trials of useAt/unrollAt.
-    void prefill(NodeId start, const std::atomic<bool>* cancel = nullptr) const;
+    // The unrolling counts the expansion on the way (subtree_count.h): returns the counts
+    // of the instances it unrolled, for countExpansion (CountOptions::known), so that the
+    // primitive count need only walk the levels above them; null when there are none.
+    std::shared_ptr<const KnownCounts> prefill(NodeId start,
+                                               const std::atomic<bool>* cancel = nullptr) const;
 
     InstanceBoxStats stats() const;
 
   private:
-    friend class BoxSink;
+    template <class>
+    friend class BoxSinkOf;
     friend class SeedSink;
     friend class SequenceInstanceBoxes;
     struct Seed;
+    class CountingWorker;
     std::vector<Seed> seedsAt(NodeId start, uint32_t depth, uint64_t maxVisits) const;
+    std::vector<Seed> prefillSeeds(NodeId start) const;
+    std::optional<KnownSubtree> unrollCounting(CountingWorker& w, const Seed& sd) const;
     struct Stored {
         Box box;
         uint64_t weight = 0;
@@ -146,6 +159,10 @@ class InstanceBoxes {
     Table& tableOf(NodeId select) const;
     bool find(NodeId select, const Key& k, Stored& out) const;
     void insert(NodeId select, const Key& k, const Stored& s) const;
+    // Whether an instance of this S-node at this depth was ever stored (then the table
+    // may hold the one asked for), and the note that one was.
+    bool mayHold(NodeId select, uint32_t depth) const;
+    void held(NodeId select, uint32_t depth) const;
     void record(NodeId select, uint32_t depth, const Stored& s) const;
 
     const Graph& g_;
@@ -159,9 +176,9 @@ class InstanceBoxes {
     mutable std::atomic<uint64_t> computed_{0};
 
     // Per (module, depth < levels_): 0 undecided, 1 use exact boxes, 2 static only;
-    // whether to expand; and the trial counters.
+    // whether to expand; whether an instance was ever stored; and the trial counters.
     uint32_t levels_ = 0;
-    mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_, expand_;
+    mutable std::unique_ptr<std::atomic<uint8_t>[]> decision_, expand_, stored_;
     mutable std::unique_ptr<std::atomic<uint32_t>[]> tried_, paid_;
     mutable std::unique_ptr<std::atomic<uint64_t>[]> minWeight_, maxWeight_;
 };

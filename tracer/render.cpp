@@ -312,7 +312,9 @@ struct RegionRenderer::State {
     void prefill() {
         std::call_once(prefilled, [this] {
             const InstanceBoxes* boxes = scene.instanceBoxes();
-            if (boxes && scene.useBounds) boxes->prefill(scene.graph().axiom, opt.cancel);
+            std::shared_ptr<const KnownCounts> counts;
+            if (boxes && scene.useBounds) counts = boxes->prefill(scene.graph().axiom, opt.cancel);
+            if (opt.prefilled) opt.prefilled(std::move(counts));
         });
     }
 };

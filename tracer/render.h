@@ -70,6 +70,10 @@ struct RenderOptions {
     std::function<void(int pass, int x0, int y0, int x1, int y1, double seconds)> tileTime;
     // When set and true, the render stops at the next tile and throws RenderCancelled.
     const std::atomic<bool>* cancel = nullptr;
+    // Called once, on a worker thread, when the instance boxes have been filled ahead of
+    // the first rays (or were not to be), with what the fill counted on the way
+    // (InstanceBoxes::prefill; null: nothing); may be empty.
+    std::function<void(std::shared_ptr<const KnownCounts>)> prefilled;
 };
 
 struct RenderCancelled : std::runtime_error {

@@ -18,13 +18,14 @@ namespace {
 
 using testing::compile;
 
-// F reads no time (only the transform above it moves with the clock); G's spheres grow
-// with the clock while the parameters G reads stay the same in every frame, so a box of
-// G kept from an earlier frame would be too small.
+// F reads no time (only the transform above it moves with the clock; 243 spheres, so that
+// its instances are large enough for the render to store: InstanceBoxOptions::minWeight);
+// G's spheres grow with the clock while the parameters G reads stay the same in every
+// frame, so a box of G kept from an earlier frame would be too small.
 const char* kScene = R"(
 camera { location <0, -9, 2>  look_at <0, 0, 0>  angle 60 }
 light  { position <10, -20, 30> }
-move(clock * 2 - 1, 0, 1) {n = 3} F ∪ move(0, 0, -1.5) {k = 3} G
+move(clock * 2 - 1, 0, 1) {n = 5} F ∪ move(0, 0, -1.5) {k = 3} G
 F if(n > 0, 2, 1)
 1: F -> sphere
 2: F -> {n = n-1} (move(0.5,0.5,0.5) uscale(0.5) F ∪ move(-0.5,-0.5,0.5) uscale(0.5) F ∪

@@ -30,6 +30,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -214,21 +215,53 @@ struct FrameContext {
     double base = 0, share = 1;
 };
 
+// What the render's instance-box fill counted (InstanceBoxes::prefill), handed to the
+// count once the fill is done, or null once the render has ended without one.
+class FillCounts {
+  public:
+    void set(std::shared_ptr<const KnownCounts> counts) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (done_) return;
+        counts_ = std::move(counts);
+        done_ = true;
+        ready_.notify_all();
+    }
+    std::shared_ptr<const KnownCounts> wait() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        ready_.wait(lock, [this] { return done_; });
+        return counts_;
+    }
+
+  private:
+    std::mutex mutex_;
+    std::condition_variable ready_;
+    bool done_ = false;
+    std::shared_ptr<const KnownCounts> counts_;
+};
+
 // The count (primitive equivalence, and the scene's run-time errors on every path) runs on
-// a thread of its own beside the render, whose first tiles need not wait for it: a long
-// count (a terrain's 2 million triangles, which do not repeat and cannot be memoised) then
-// shares the cores with the render instead of leaving all but one idle. What is reported
-// stays the serial order's: an error of the count wins over the render's (the render is
-// cancelled and its pixels dropped), then the render's own error; nothing is written
-// unless both succeed.
-void countBesideRender(const Graph& g, const CountOptions& co, tracer::RenderOptions ro,
+// a thread of its own beside the render. It waits for the render's instance-box fill,
+// which unrolls the instances below a few dozen S-node instances (a terrain's 2 million
+// triangles, which do not repeat and cannot be memoised) in parallel before the first
+// rays and counts them on the way: the count takes those counts and walks only the
+// levels above them, and what the fill could not count (a run-time error there, a part
+// found stored) itself. What is reported stays the serial order's: an error of the count
+// wins over the render's (the render is cancelled and its pixels dropped), then the
+// render's own error; nothing is written unless both succeed.
+void countBesideRender(const Graph& g, CountOptions co, tracer::RenderOptions ro,
                        RenderReport& report) {
     std::atomic<bool> cancel{false};
     if (ro.cancel) throw std::logic_error("countBesideRender: the render has its own cancel flag");
     ro.cancel = &cancel;
+    auto fill = std::make_shared<FillCounts>();
+    ro.prefilled = [fill](std::shared_ptr<const KnownCounts> counts) {
+        fill->set(std::move(counts));
+    };
     std::exception_ptr countError, renderError;
     std::thread counter([&] {
         try {
+            const std::shared_ptr<const KnownCounts> known = fill->wait();
+            co.known = known.get();
             report.count = countExpansion(g, co);
         } catch (...) {
             countError = std::current_exception();
@@ -240,6 +273,7 @@ void countBesideRender(const Graph& g, const CountOptions& co, tracer::RenderOpt
     } catch (...) {
         renderError = std::current_exception();
     }
+    fill->set(nullptr);  // (the render ended before its fill: the count walks everything)
     counter.join();
     if (countError) std::rethrow_exception(countError);
     if (renderError) std::rethrow_exception(renderError);
