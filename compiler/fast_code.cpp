@@ -149,29 +149,55 @@ FastInstr plainToFast(const Instr& in) {
     return f;
 }
 
+// The fast instruction for the plain code at pc: a leaf and the binary operator that takes
+// it, two leaves (a constant and a parameter) and theirs, or one instruction; returns how
+// many plain instructions it stands for. An operator that is a jump target is not fused.
+uint32_t fuse(const Graph& g, uint32_t pc, uint32_t end, const std::vector<uint8_t>& target,
+              uint32_t begin, FastInstr& f) {
+    const Instr& in = g.code[pc];
+    const auto fusable = [&](uint32_t i) {
+        return i < end && isBinary(g.code[i].op) && !target[i - begin];
+    };
+    if (isLeaf(in.op) && pc + 2 < end + 1 && isLeaf(g.code[pc + 1].op) &&
+        in.op != g.code[pc + 1].op && !target[pc + 1 - begin] && fusable(pc + 2)) {
+        const bool constFirst = in.op == Op::Const;
+        const Instr& k = constFirst ? in : g.code[pc + 1];
+        const Instr& l = constFirst ? g.code[pc + 1] : in;
+        f = FastInstr{binaryForm(g.code[pc + 2].op, constFirst ? FastOp::AddKL : FastOp::AddLK), 0,
+                      l.a, k.imm};
+        return 3;
+    }
+    if (isLeaf(in.op) && fusable(pc + 1)) {
+        const FastOp form = in.op == Op::Const ? FastOp::AddK : FastOp::AddL;
+        f = FastInstr{binaryForm(g.code[pc + 1].op, form), 0, in.a, in.imm};
+        return 2;
+    }
+    f = plainToFast(in);
+    return 1;
+}
+
 // Appends the fast form of the plain code [begin, end) to g.fastCode, without its End;
-// false (and nothing appended) when the fast machine cannot run it.
-bool translate(Graph& g, uint32_t begin, uint32_t end) {
+// false (and nothing appended) when the fast machine cannot run it. `held`: the slot the
+// instruction before stored and that acc still holds (a Store that may become StoreKeep).
+bool translate(Graph& g, uint32_t begin, uint32_t end, Slot held = kNone) {
     CodeShape s;
     if (begin >= end || end > g.code.size() || !shapeOf(g, begin, end, s)) return false;
     std::vector<uint32_t> newPc(end - begin + 1, 0);
     std::vector<size_t> jumps;
-    for (uint32_t pc = begin; pc < end; ++pc) {
-        newPc[pc - begin] = static_cast<uint32_t>(g.fastCode.size());
-        const Instr& in = g.code[pc];
-        if (isLeaf(in.op) && pc + 1 < end && isBinary(g.code[pc + 1].op) &&
-            !s.target[pc + 1 - begin]) {
-            // a leaf and the operator that takes it: one instruction
-            FastInstr f{
-                binaryForm(g.code[pc + 1].op, in.op == Op::Const ? FastOp::AddK : FastOp::AddL), 0,
-                in.a, in.imm};
-            g.fastCode.push_back(f);
-            ++pc;
-            newPc[pc - begin] = newPc[pc - begin - 1];
-            continue;
-        }
-        if (in.op == Op::Jump || in.op == Op::JumpIfZero) jumps.push_back(g.fastCode.size());
-        g.fastCode.push_back(plainToFast(in));
+    uint32_t pc = begin;
+    if (held != kNone && g.code[pc].op == Op::Load && g.code[pc].a == held) {
+        g.fastCode.back().op = FastOp::StoreKeep;  // acc already holds the value
+        newPc[0] = static_cast<uint32_t>(g.fastCode.size());
+        ++pc;
+    }
+    while (pc < end) {
+        FastInstr f;
+        const uint32_t n = fuse(g, pc, end, s.target, begin, f);
+        for (uint32_t i = 0; i < n; ++i)
+            newPc[pc + i - begin] = static_cast<uint32_t>(g.fastCode.size());
+        if (f.op == FastOp::Jump || f.op == FastOp::JumpIfZero) jumps.push_back(g.fastCode.size());
+        g.fastCode.push_back(f);
+        pc += n;
     }
     newPc[end - begin] = static_cast<uint32_t>(g.fastCode.size());
     for (size_t j : jumps) g.fastCode[j].a = newPc[g.fastCode[j].a - begin];
@@ -185,16 +211,20 @@ uint32_t translateExpr(Graph& g, const Expr& e) {
     return start;
 }
 
+// In order (not simultaneous), the frame the values read is the one they are stored in:
+// an assignment that starts by reading the slot the one before stored keeps it in acc.
 uint32_t translateCalc(Graph& g, const Calc& c) {
     const auto start = static_cast<uint32_t>(g.fastCode.size());
+    Slot held = kNone;
     for (uint32_t i = 0; i < c.count; ++i) {
         const Assignment& as = g.assignments[c.first + i];
         const Expr& e = g.exprs[as.value];
-        if (!translate(g, e.begin, e.end)) {
+        if (!translate(g, e.begin, e.end, held)) {
             g.fastCode.resize(start);
             return kNoFast;
         }
         g.fastCode.push_back(FastInstr{FastOp::Store, 0, as.slot});
+        held = c.simultaneous ? kNone : as.slot;
     }
     g.fastCode.push_back(FastInstr{FastOp::End});
     return start;
@@ -208,7 +238,11 @@ constexpr const char* kOpNames[] = {
     "Eq",    "Ne",    "AddK",      "SubK",      "MulK",      "DivK",       "ModK",  "PowK",
     "LtK",   "LeK",   "GtK",       "GeK",       "EqK",       "NeK",        "AddL",  "SubL",
     "MulL",  "DivL",  "ModL",      "PowL",      "LtL",       "LeL",        "GtL",   "GeL",
-    "EqL",   "NeL",   "Call",      "Choose",    "Jump",      "JumpIfZero", "Store", "End",
+    "EqL",   "NeL",   "AddKL",     "SubKL",     "MulKL",     "DivKL",      "ModKL", "PowKL",
+    "LtKL",  "LeKL",  "GtKL",      "GeKL",      "EqKL",      "NeKL",       "AddLK", "SubLK",
+    "MulLK", "DivLK", "ModLK",     "PowLK",     "LtLK",      "LeLK",       "GtLK",  "GeLK",
+    "EqLK",  "NeLK",  "Call",      "Choose",    "Jump",      "JumpIfZero", "Store", "StoreKeep",
+    "End",
 };
 static_assert(std::size(kOpNames) == static_cast<size_t>(FastOp::End) + 1);
 
@@ -225,7 +259,11 @@ std::string dumpFrom(const Graph& g, uint32_t start) {
         out += fmt::format("{:4}  {}", pc - start, kOpNames[op]);
         if (in.op == FastOp::PushK || (in.op >= FastOp::AddK && in.op <= FastOp::NeK))
             out += fmt::format(" {}", in.imm);
-        else if (in.op == FastOp::PushL || in.op == FastOp::Store ||
+        else if (in.op >= FastOp::AddKL && in.op <= FastOp::NeKL)
+            out += fmt::format(" {} {}", in.imm, slotName(g, in.a));
+        else if (in.op >= FastOp::AddLK && in.op <= FastOp::NeLK)
+            out += fmt::format(" {} {}", slotName(g, in.a), in.imm);
+        else if (in.op == FastOp::PushL || in.op == FastOp::Store || in.op == FastOp::StoreKeep ||
                  (in.op >= FastOp::AddL && in.op <= FastOp::NeL))
             out += fmt::format(" {}", slotName(g, in.a));
         else if (in.op == FastOp::Jump || in.op == FastOp::JumpIfZero)

@@ -17,48 +17,51 @@ inline bool unassignedBits(double v) {
 }
 }  // namespace
 
-// One binary operator in its three forms: the left operand popped, a constant, a parameter.
-#define PCSG_FAST_BINARY(OP, EXPR)             \
-    case FastOp::OP: {                         \
-        const double a = st[--sp], b = acc;    \
-        acc = (EXPR);                          \
-        break;                                 \
-    }                                          \
-    case FastOp::OP##K: {                      \
-        const double a = acc, b = in.imm;      \
-        acc = (EXPR);                          \
-        break;                                 \
-    }                                          \
-    case FastOp::OP##L: {                      \
-        const double a = acc, b = frame[in.a]; \
-        if (unassignedBits(b)) return false;   \
-        acc = (EXPR);                          \
-        break;                                 \
+// One binary operator in its five forms: the left operand popped, then a constant, a
+// parameter, both leaves (constant and parameter, parameter and constant). `FIX` runs after
+// the operation: for Add and Mul of two NaNs, x86 gives the first operand's NaN
+// (quietened), and the plain machine's `a + b` takes a as the first; here the compiler may
+// swap the operands of a commutative operator, so the first's NaN is restored explicitly
+// (the sign and payload of a NaN reach rand(x) and the error messages).
+#define PCSG_FAST_BINARY(OP, EXPR, FIX)           \
+    case FastOp::OP: {                            \
+        const double a = st[--sp], b = acc;       \
+        acc = (EXPR);                             \
+        FIX;                                      \
+        break;                                    \
+    }                                             \
+    case FastOp::OP##K: {                         \
+        const double a = acc, b = in.imm;         \
+        acc = (EXPR);                             \
+        FIX;                                      \
+        break;                                    \
+    }                                             \
+    case FastOp::OP##L: {                         \
+        const double a = acc, b = frame[in.a];    \
+        if (unassignedBits(b)) return false;      \
+        acc = (EXPR);                             \
+        FIX;                                      \
+        break;                                    \
+    }                                             \
+    case FastOp::OP##KL: {                        \
+        const double a = in.imm, b = frame[in.a]; \
+        if (unassignedBits(b)) return false;      \
+        st[sp++] = acc;                           \
+        acc = (EXPR);                             \
+        FIX;                                      \
+        break;                                    \
+    }                                             \
+    case FastOp::OP##LK: {                        \
+        const double a = frame[in.a], b = in.imm; \
+        if (unassignedBits(a)) return false;      \
+        st[sp++] = acc;                           \
+        acc = (EXPR);                             \
+        FIX;                                      \
+        break;                                    \
     }
-// Add and Mul of two NaNs: x86 gives the first operand's NaN (quietened), and the plain
-// machine's `a + b` takes a as the first; here the compiler may swap the operands of a
-// commutative operator, so the first's NaN is restored explicitly (the sign and payload of a
-// NaN reach rand(x) and the error messages).
-#define PCSG_FAST_COMMUTATIVE(OP, SYMBOL)           \
-    case FastOp::OP: {                              \
-        const double a = st[--sp], b = acc;         \
-        acc = a SYMBOL b;                           \
-        if (acc != acc && a != a) acc = a SYMBOL a; \
-        break;                                      \
-    }                                               \
-    case FastOp::OP##K: {                           \
-        const double a = acc, b = in.imm;           \
-        acc = a SYMBOL b;                           \
-        if (acc != acc && a != a) acc = a SYMBOL a; \
-        break;                                      \
-    }                                               \
-    case FastOp::OP##L: {                           \
-        const double a = acc, b = frame[in.a];      \
-        if (unassignedBits(b)) return false;        \
-        acc = a SYMBOL b;                           \
-        if (acc != acc && a != a) acc = a SYMBOL a; \
-        break;                                      \
-    }
+#define PCSG_FAST_FIRST_NAN(SYMBOL) \
+    if (acc != acc && a != a) acc = a SYMBOL a
+#define PCSG_FAST_NO_FIX (void)0
 #define PCSG_FAST_PUSH(OP, EXPR) \
     case FastOp::OP:             \
         st[sp++] = acc;          \
@@ -106,18 +109,18 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
                 PCSG_FAST_UNARY(Floor, std::floor(acc))
                 PCSG_FAST_UNARY(Ceil, std::ceil(acc))
                 PCSG_FAST_UNARY(Rand1, randOfInline(seed, acc))
-                PCSG_FAST_COMMUTATIVE(Add, +)
-                PCSG_FAST_BINARY(Sub, a - b)
-                PCSG_FAST_COMMUTATIVE(Mul, *)
-                PCSG_FAST_BINARY(Div, a / b)
-                PCSG_FAST_BINARY(Mod, std::fmod(a, b))
-                PCSG_FAST_BINARY(Pow, std::pow(a, b))
-                PCSG_FAST_BINARY(Lt, a < b ? 1.0 : 0.0)
-                PCSG_FAST_BINARY(Le, a <= b ? 1.0 : 0.0)
-                PCSG_FAST_BINARY(Gt, a > b ? 1.0 : 0.0)
-                PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0)
-                PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0)
-                PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0)
+                PCSG_FAST_BINARY(Add, a + b, PCSG_FAST_FIRST_NAN(+))
+                PCSG_FAST_BINARY(Sub, a - b, PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Mul, a * b, PCSG_FAST_FIRST_NAN(*))
+                PCSG_FAST_BINARY(Div, a / b, PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Mod, std::fmod(a, b), PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Pow, std::pow(a, b), PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Lt, a < b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Le, a <= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Gt, a > b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+                PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
             case FastOp::Call:
                 st[sp] = acc, sp -= in.argc - 1u;
                 acc = callFunc(static_cast<Func>(in.a), st + sp, in.argc, seed);
@@ -139,6 +142,10 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
             case FastOp::Store:
                 out[in.a] = acc, acc = st[--sp];
                 break;
+            case FastOp::StoreKeep:
+                if (unassignedBits(acc)) return false;
+                out[in.a] = acc;
+                break;
             case FastOp::End:
                 result = acc;
                 return true;
@@ -149,6 +156,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 #undef PCSG_FAST_BINARY
 #undef PCSG_FAST_UNARY
 #undef PCSG_FAST_PUSH
-#undef PCSG_FAST_COMMUTATIVE
+#undef PCSG_FAST_FIRST_NAN
+#undef PCSG_FAST_NO_FIX
 
 }  // namespace pcsg

@@ -8,8 +8,10 @@
 // The machine keeps the top of the stack in a register, `acc`; a push spills acc to the
 // stack, a binary operator takes its left operand from the stack. A leaf operand (a
 // constant or a parameter) followed by a binary operator is one instruction (`AddK 1.0`,
-// `MulL x`), a one-argument function is one instruction (`Ln`), and a C-node's assignments
-// are one program ending each value with `Store slot`.
+// `MulL x`), and so are two leaves and their operator (`MulKL 255 x`: 255 * x); a
+// one-argument function is one instruction (`Ln`), and a C-node's assignments are one
+// program ending each value with `Store slot` (`StoreKeep` when the next value starts by
+// reading the slot just stored).
 #pragma once
 
 #include <cstdint>
@@ -80,12 +82,39 @@ enum class FastOp : uint8_t {
     GeL,
     EqL,
     NeL,
+    // spill acc, then acc = imm op frame[a] (checked as PushL)
+    AddKL,
+    SubKL,
+    MulKL,
+    DivKL,
+    ModKL,
+    PowKL,
+    LtKL,
+    LeKL,
+    GtKL,
+    GeKL,
+    EqKL,
+    NeKL,
+    // spill acc, then acc = frame[a] op imm (checked as PushL)
+    AddLK,
+    SubLK,
+    MulLK,
+    DivLK,
+    ModLK,
+    PowLK,
+    LtLK,
+    LeLK,
+    GtLK,
+    GeLK,
+    EqLK,
+    NeLK,
     // argc values (acc the last): acc = Func a of them / choose() at call site a
     Call,
     Choose,
     Jump,        // pc = a (absolute index into Graph::fastCode)
     JumpIfZero,  // v = acc, pop; if v == 0, pc = a
     Store,       // out[a] = acc, pop (a C-node's assignment)
+    StoreKeep,   // out[a] = acc, kept: Store a then PushL a where the frame is `out`
     End,         // the value is acc
 };
 
