@@ -15,6 +15,14 @@ bool isLeaf(Op op) {
 bool isBinary(Op op) {
     return op >= Op::Add && op <= Op::Ne;
 }
+// The binary operator an instruction is: an operator, or pow(a, b) and mod(a, b), which
+// compute what the operators ^ and % compute (std::pow, std::fmod); Op::Const otherwise.
+Op binaryOf(const Instr& in) {
+    if (isBinary(in.op)) return in.op;
+    if (in.op == Op::Call && in.argc == 2 && static_cast<Func>(in.a) == Func::Pow) return Op::Pow;
+    if (in.op == Op::Call && in.argc == 2 && static_cast<Func>(in.a) == Func::Mod) return Op::Mod;
+    return Op::Const;
+}
 // The binary operator `op` in the form with base `form` (FastOp::Add, AddK or AddL).
 FastOp binaryForm(Op op, FastOp form) {
     return static_cast<FastOp>(static_cast<int>(form) + static_cast<int>(op) -
@@ -128,6 +136,11 @@ FastInstr plainToFast(const Instr& in) {
             f.op = FastOp::JumpIfZero;
             break;
         case Op::Call:
+            if (binaryOf(in) != Op::Const) {
+                f.op = binaryForm(binaryOf(in), FastOp::Add);
+                f.argc = 0;
+                break;
+            }
             if (in.argc != 1 || !unaryFunc(static_cast<Func>(in.a), f.op)) f.op = FastOp::Call;
             break;
         case Op::Rand0:
@@ -156,20 +169,21 @@ uint32_t fuse(const Graph& g, uint32_t pc, uint32_t end, const std::vector<uint8
               uint32_t begin, FastInstr& f) {
     const Instr& in = g.code[pc];
     const auto fusable = [&](uint32_t i) {
-        return i < end && isBinary(g.code[i].op) && !target[i - begin];
+        return i < end && binaryOf(g.code[i]) != Op::Const && !target[i - begin];
     };
     if (isLeaf(in.op) && pc + 2 < end + 1 && isLeaf(g.code[pc + 1].op) &&
         in.op != g.code[pc + 1].op && !target[pc + 1 - begin] && fusable(pc + 2)) {
         const bool constFirst = in.op == Op::Const;
         const Instr& k = constFirst ? in : g.code[pc + 1];
         const Instr& l = constFirst ? g.code[pc + 1] : in;
-        f = FastInstr{binaryForm(g.code[pc + 2].op, constFirst ? FastOp::AddKL : FastOp::AddLK), 0,
-                      l.a, k.imm};
+        f = FastInstr{
+            binaryForm(binaryOf(g.code[pc + 2]), constFirst ? FastOp::AddKL : FastOp::AddLK), 0,
+            l.a, k.imm};
         return 3;
     }
     if (isLeaf(in.op) && fusable(pc + 1)) {
         const FastOp form = in.op == Op::Const ? FastOp::AddK : FastOp::AddL;
-        f = FastInstr{binaryForm(g.code[pc + 1].op, form), 0, in.a, in.imm};
+        f = FastInstr{binaryForm(binaryOf(g.code[pc + 1]), form), 0, in.a, in.imm};
         return 2;
     }
     f = plainToFast(in);
