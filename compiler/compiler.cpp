@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "builder.h"
+#include "fast_code.h"
 #include "fold_constants.h"
 #include "lexer.h"
 #include "parser.h"
@@ -41,6 +42,7 @@ std::optional<Graph> compileSource(std::string_view fileName, std::string_view t
     std::optional<Graph> g = build(src, tokens, ast, diags);
     if (diags.count() != errorsBefore) return std::nullopt;
     if (g && options.foldConstants) foldConstantParameters(*g);
+    if (g) buildFastCode(*g);  // last: it translates the code as it now stands
     return g;
 }
 

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "eval_core.h"
+
 namespace pcsg {
 
 // ---------------------------------------------------------------------------------------
@@ -63,18 +65,6 @@ std::string describeFrame(const Graph& g, const double* frame) {
 // ---------------------------------------------------------------------------------------
 // Instance paths and randomness.
 
-namespace {
-// SplitMix64's finaliser: a bijective 64-bit mixer.
-constexpr uint64_t mix64(uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-constexpr double toUnit(uint64_t h) {
-    return static_cast<double>(h >> 11) * 0x1.0p-53;
-}
-}  // namespace
-
 uint64_t pathChild(uint64_t path, uint32_t childIndex) {
     return mix64(path ^ (0x6a09e667f3bcc908ULL + (static_cast<uint64_t>(childIndex) << 1)));
 }
@@ -83,13 +73,11 @@ uint64_t pathRule(uint64_t path, uint32_t ruleIndex) {
 }
 
 double randOf(uint64_t seed, double x) {
-    if (x == 0) x = 0;  // -0 and +0 are the same argument
-    const uint64_t bits = std::bit_cast<uint64_t>(x);
-    return toUnit(mix64(mix64(bits ^ 0x3c6ef372fe94f82bULL) ^ mix64(seed + 0xa54ff53a5f1d36f1ULL)));
+    return randOfInline(seed, x);
 }
 
 double randAt(uint64_t seed, uint64_t path, uint32_t callSite) {
-    return toUnit(mix64(mix64(path ^ mix64(seed + 0x510e527fade682d1ULL)) + callSite));
+    return randAtInline(seed, path, callSite);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -104,6 +92,8 @@ constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
                                           "this path (in '{}')",
                                           g.slotNames[s], e.text));
 }
+
+}  // namespace
 
 double callFunc(Func f, const double* a, uint32_t n, uint64_t seed) {
     switch (f) {
@@ -152,10 +142,35 @@ double callFunc(Func f, const double* a, uint32_t n, uint64_t seed) {
         case Func::Clamp:
             return std::fmin(std::fmax(a[0], a[1]), a[2]);
         case Func::Rand1:
-            return randOf(seed, a[0]);
+            return randOfInline(seed, a[0]);
     }
     return std::nan("");
 }
+
+bool chooseWeightsValid(const double* w, uint32_t n) {
+    double total = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!(w[i] >= 0) || !std::isfinite(w[i])) return false;
+        total += w[i];
+    }
+    return total > 0;
+}
+
+double choosePick(const double* w, uint32_t n, double u) {
+    double total = 0;
+    for (uint32_t i = 0; i < n; ++i) total += w[i];
+    const double x = u * total;
+    double acc = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        acc += w[i];
+        if (x < acc && w[i] > 0) return i + 1;
+    }
+    for (uint32_t i = n; i-- > 0;)  // rounding: the last rule with a positive weight
+        if (w[i] > 0) return i + 1;
+    return n;
+}
+
+namespace {
 
 // choose(w1..wn): a rule number 1..n with probability proportional to the weights.
 double chooseRule(const Graph& g, const Expr& e, const double* w, uint32_t n, double u) {
@@ -169,15 +184,7 @@ double chooseRule(const Graph& g, const Expr& e, const double* w, uint32_t n, do
     }
     if (!(total > 0))
         throw RuntimeError(e.loc, fmt::format("choose() weights are all zero in '{}'", e.text));
-    const double x = u * total;
-    double acc = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-        acc += w[i];
-        if (x < acc && w[i] > 0) return i + 1;
-    }
-    for (uint32_t i = n; i-- > 0;)  // rounding: the last rule with a positive weight
-        if (w[i] > 0) return i + 1;
-    return n;
+    return choosePick(w, n, u);
 }
 
 double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
@@ -261,6 +268,8 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
 
 double evalExpr(const Graph& g, ExprId id, EvalState s) {
     const Expr& e = g.exprs[id];
+    double v;
+    if (e.fast != kNoFast && runFast(g, e.fast, s.frame, nullptr, s.path, v)) return v;
     constexpr uint32_t kSmall = 64;
     if (e.maxStack <= kSmall) {
         double stack[kSmall];
@@ -315,6 +324,12 @@ uint32_t selectRule(const Graph& g, NodeId n, EvalState s) {
 void applyCalc(const Graph& g, NodeId n, EvalState in, double* out) {
     const Calc& c = g.calcs[g.nodes[n].payload];
     std::memcpy(out, in.frame, g.slotCount() * sizeof(double));
+    if (c.fast != kNoFast) {
+        double unused;
+        if (runFast(g, c.fast, c.simultaneous ? in.frame : out, out, in.path, unused)) return;
+        // the plain code below reports the error
+        std::memcpy(out, in.frame, g.slotCount() * sizeof(double));
+    }
     const Assignment* as = g.assignments.data() + c.first;
     if (!c.simultaneous) {
         const EvalState cur{out, in.path};

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "eval.h"
+#include "fast_code.h"
 
 namespace pcsg {
 
@@ -139,6 +140,7 @@ bool constantArgs(const Graph& g, uint32_t first, uint32_t count, std::vector<do
 
 size_t foldConstantParameters(Graph& g) {
     if (g.axiom == kNone) return 0;
+    dropFastCode(g);  // it rewrites the code; the compiler builds the fast form after
     // Each slot is checked against the whole graph: skip graphs where that would be a lot
     // of work (huge generated files); they are only slower to render, never wrong.
     const uint64_t work = static_cast<uint64_t>(g.slotCount()) *

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "csg_op.h"
+#include "fast_instr.h"
 #include "geometry.h"
 #include "texture.h"
 
@@ -107,6 +108,7 @@ struct Expr {
     bool constant = false;        // reads no slot, no clock or frame, calls no rand()/choose()
     bool usesPath = false;        // calls rand() or choose(): depends on the instance path
     bool usesTime = false;        // reads clock or frame
+    uint32_t fast = kNoFast;      // its fast form's first instruction in Graph::fastCode
     FileLoc loc;
     std::string text;  // the source text, for run-time error messages
 };
@@ -183,6 +185,7 @@ struct Calc {
     // true: all values are computed from the incoming frame, then assigned together
     //       (a notation-B call S(e1, e2) on formals (c1, c2)).
     bool simultaneous = false;
+    uint32_t fast = kNoFast;  // all assignments as one program in Graph::fastCode
 };
 
 enum class PrimitiveKind : uint8_t {
@@ -362,6 +365,7 @@ struct Graph {
 
     std::vector<Expr> exprs;
     std::vector<Instr> code;
+    std::vector<FastInstr> fastCode;     // the fast form of `code` (fast_code.h), built last
     std::vector<std::string> slotNames;  // parameter names, by slot
     uint32_t randCallSites = 0;          // number of rand()/choose() call sites
 

@@ -1,0 +1,306 @@
+// The fast form of the expression code (fast_code.h): each instruction form gives the
+// double the plain code gives, bit for bit, on ordinary and extreme values (NaN, the
+// infinities, -0), and errors still come out as the plain code words them.
+#include "fast_code.h"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "compile_test_util.h"
+#include "eval.h"
+
+namespace pcsg {
+namespace {
+
+// Scenes whose C-node assigns r1, r2, ... the expressions under test (the axiom's sets x, y,
+// z so that they compile, unfolded, so that they stay parameters; w is assigned on
+// another path only).
+std::unique_ptr<testing::Compiled> withExprs(const std::vector<std::string>& exprs) {
+    std::string text = "{x = 1; y = 2; z = 3} ({";
+    for (size_t i = 0; i < exprs.size(); ++i)
+        text += "r" + std::to_string(i + 1) + " = " + exprs[i] + "; ";
+    text += "} sphere ∪ {w = 0} cube)\n";
+    auto c = testing::compileUnfolded(text);
+    if (!c->graph) ADD_FAILURE() << c->errors();
+    return c;
+}
+
+// The C-node that assigns r1.
+uint32_t calcUnderTest(const Graph& g) {
+    for (uint32_t i = 0; i < g.calcs.size(); ++i) {
+        const Assignment& a = g.assignments[g.calcs[i].first];
+        if (g.calcs[i].count && g.slotNames[a.slot] == "r1") return i;
+    }
+    ADD_FAILURE() << "no C-node assigns r1";
+    return 0;
+}
+
+// The graph without its fast form: everything runs the plain code.
+Graph plainOf(const Graph& g) {
+    Graph p = g;
+    dropFastCode(p);
+    return p;
+}
+
+const double kInf = std::numeric_limits<double>::infinity();
+const double kValues[] = {0,   -0.0, 1,     -1,      0.5,  2.5,   90,           -270,
+                          360, 3,    1e300, -1e-300, kInf, -kInf, std::nan(""), 7.25};
+
+// Fills every slot but w with values drawn from kValues.
+void randomFrame(const Graph& g, std::mt19937& rng, std::vector<double>& frame) {
+    frame.assign(g.slotCount(), 0);
+    initFrame(g, frame.data());
+    std::uniform_int_distribution<size_t> pick(0, std::size(kValues) - 1);
+    for (Slot s = 0; s < g.slotCount(); ++s)
+        if (g.slotNames[s] != "w") frame[s] = kValues[pick(rng)];
+}
+
+uint64_t bits(double v) {
+    return std::bit_cast<uint64_t>(v);
+}
+
+NodeId calcNodeUnderTest(const Graph& g) {
+    for (NodeId n = 0; n < g.nodes.size(); ++n)
+        if (g.nodes[n].kind == NodeKind::Calc && g.nodes[n].payload == calcUnderTest(g)) return n;
+    ADD_FAILURE() << "no C-node";
+    return 0;
+}
+
+// Every expression of the C-node under test, and the C-node as a whole, evaluated fast and
+// plain on many frames.
+void expectSameValues(const Graph& g, int frames = 400) {
+    const Graph plain = plainOf(g);
+    const Calc& c = g.calcs.at(calcUnderTest(g));
+    const NodeId node = calcNodeUnderTest(g);
+    ASSERT_NE(c.fast, kNoFast);
+    std::mt19937 rng(7);
+    std::vector<double> frame;
+    for (int k = 0; k < frames; ++k) {
+        randomFrame(g, rng, frame);
+        const EvalState s{frame.data(), pathChild(kRootPath, k)};
+        for (uint32_t i = 0; i < c.count; ++i) {
+            const ExprId e = g.assignments[c.first + i].value;
+            ASSERT_NE(g.exprs[e].fast, kNoFast) << g.exprs[e].text;
+            EXPECT_EQ(bits(evalExpr(g, e, s)), bits(evalExpr(plain, e, s)))
+                << g.exprs[e].text << " with " << describeFrame(g, frame.data());
+        }
+        std::vector<double> fast(g.slotCount()), slow(g.slotCount());
+        applyCalc(g, node, s, fast.data());
+        applyCalc(plain, node, s, slow.data());
+        for (Slot i = 0; i < g.slotCount(); ++i)
+            EXPECT_EQ(bits(fast[i]), bits(slow[i])) << g.slotNames[i];
+    }
+}
+
+TEST(FastCode, EachBinaryFormGivesThePlainValue) {
+    // For each operator: the left operand popped (both sides computed), a constant on the
+    // right (left computed), a parameter on the right, and both leaves either way round.
+    const char* ops[] = {"+", "-", "*", "/", "%", "^", "<", "<=", ">", ">=", "==", "!="};
+    const char* names[] = {"Add", "Sub", "Mul", "Div", "Mod", "Pow",
+                           "Lt",  "Le",  "Gt",  "Ge",  "Eq",  "Ne"};
+    std::vector<std::string> exprs, forms;
+    for (size_t i = 0; i < std::size(ops); ++i) {
+        const std::string op = ops[i], name = names[i];
+        exprs.insert(exprs.end(), {"(x+y) " + op + " (y*z)", "(x*y) " + op + " 2",
+                                   "(x*z) " + op + " y", "2 " + op + " y", "y " + op + " 2"});
+        forms.insert(forms.end(), {"  " + name + "\n", "  " + name + "K 2\n", "  " + name + "L y\n",
+                                   "  " + name + "KL 2 y\n", "  " + name + "LK y 2\n"});
+    }
+    exprs.push_back("r60 * 3");  // reads the slot the assignment before stored
+    forms.push_back("StoreKeep r60");
+    auto c = withExprs(exprs);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    expectSameValues(g);
+    const std::string dump = dumpFastCalc(g, calcUnderTest(g));
+    for (const std::string& form : forms)
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+}
+
+TEST(FastCode, FunctionsBranchesAndTimeGiveThePlainValue) {
+    const std::vector<std::string> exprs = {"sin(x)",
+                                            "cos(x)",
+                                            "tan(x)",
+                                            "asin(x)",
+                                            "acos(x)",
+                                            "atan(x)",
+                                            "sqrt(x)",
+                                            "exp(x)",
+                                            "ln(x)",
+                                            "log10(x)",
+                                            "abs(x)",
+                                            "floor(x)",
+                                            "ceil(x)",
+                                            "rand(x)",
+                                            "rand()",
+                                            "atan2(x, y)",
+                                            "pow(x, y)",
+                                            "min(x, y, z)",
+                                            "max(x, y)",
+                                            "mod(x, y)",
+                                            "clamp(x, y, z)",
+                                            "if(x, y, z)",
+                                            "x && y && z",
+                                            "x || y || z",
+                                            "!x",
+                                            "-x",
+                                            "clock + frame * x",
+                                            "if(x > y, if(z, 1, y), -z) + 1",
+                                            "((-ln(rand(x)*y+1.0))+z)*x",
+                                            "choose(1, 2, 3)"};
+    auto c = withExprs(exprs);
+    ASSERT_TRUE(c->graph);
+    expectSameValues(*c->graph);
+    const std::string dump = dumpFastCalc(*c->graph, calcUnderTest(*c->graph));
+    for (const char* form :
+         {"Sin\n", "PowL y\n", "ModL y\n", "Ln\n", "Rand1\n", "PushRand0", "Call", "JumpIfZero",
+          "Jump", "ToBool", "Not\n", "Neg\n", "PushClock", "PushFrame", "Choose"})
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+}
+
+TEST(FastCode, AnExpressionsFormIsLeafAndOperatorInOneInstruction) {
+    auto c = withExprs({"((-ln(rand(x)*y+1.0))+z)*x"});
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const ExprId e = g.assignments[g.calcs[calcUnderTest(g)].first].value;
+    EXPECT_EQ(dumpFastExpr(g, e),
+              "   0  PushL x\n   1  Rand1\n   2  MulL y\n   3  AddK 1\n   4  Ln\n"
+              "   5  Neg\n   6  AddL z\n   7  MulL x\n   8  End\n");
+}
+
+// The error a call gives, as text ("" when it gives none).
+template <class F>
+std::string errorOf(const Graph& g, F f) {
+    try {
+        f();
+    } catch (const RuntimeError& e) {
+        return e.format(g);
+    }
+    return "";
+}
+
+TEST(FastCode, UnassignedReadsAreReportedAsThePlainCodeReportsThem) {
+    // w is assigned only on another path: reading it here is the run-time error.
+    auto c = withExprs({"x + 1", "y * w", "w", "2 - w", "1 + (x * w)"});
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Graph plain = plainOf(g);
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    for (const char* name : {"x", "y", "z"})
+        for (Slot s = 0; s < g.slotCount(); ++s)
+            if (g.slotNames[s] == name) frame[s] = 2;
+    const Calc& calc = g.calcs[calcUnderTest(g)];
+    for (uint32_t i = 1; i < calc.count; ++i) {
+        const ExprId e = g.assignments[calc.first + i].value;
+        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
+        EXPECT_NE(fast.find("parameter 'w' is read before it is assigned"), std::string::npos)
+            << fast;
+        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
+    }
+    // the C-node as a whole: the same error, and the frame it fills is not half-written
+    NodeId calcNode = kNone;
+    for (NodeId n = 0; n < g.nodes.size(); ++n)
+        if (g.nodes[n].kind == NodeKind::Calc && g.nodes[n].payload == calcUnderTest(g))
+            calcNode = n;
+    ASSERT_NE(calcNode, kNone);
+    std::vector<double> out(g.slotCount());
+    const auto apply = [&](const Graph& gr) {
+        return errorOf(gr, [&] { applyCalc(gr, calcNode, {frame.data(), kRootPath}, out.data()); });
+    };
+    const std::string fast = apply(g);
+    EXPECT_NE(fast.find("'w'"), std::string::npos) << fast;
+    EXPECT_EQ(fast, apply(plain));
+}
+
+TEST(FastCode, ChooseWeightErrorsAreReportedAsThePlainCodeReportsThem) {
+    auto c = withExprs({"choose(x, y)"});
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Graph plain = plainOf(g);
+    const ExprId e = g.assignments[g.calcs[calcUnderTest(g)].first].value;
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    const auto run = [&](const Graph& gr, double x, double y) {
+        for (Slot s = 0; s < g.slotCount(); ++s) {
+            if (g.slotNames[s] == "x") frame[s] = x;
+            if (g.slotNames[s] == "y") frame[s] = y;
+        }
+        return errorOf(gr, [&] { evalExpr(gr, e, {frame.data(), kRootPath}); });
+    };
+    for (auto [x, y] : {std::pair{-1.0, 1.0}, {0.0, 0.0}, {kInf, 1.0}, {1.0, std::nan("")}}) {
+        const std::string fast = run(g, x, y);
+        EXPECT_NE(fast.find("choose() weight"), std::string::npos) << fast;
+        EXPECT_EQ(fast, run(plain, x, y));
+    }
+    EXPECT_EQ(run(g, 1, 2), "");
+}
+
+// Appends raw plain code as an expression (as eval_test.cpp does).
+ExprId addCode(Graph& g, std::vector<Instr> code) {
+    Expr e;
+    e.begin = static_cast<uint32_t>(g.code.size());
+    for (auto& in : code) {
+        if (in.op == Op::Jump || in.op == Op::JumpIfZero) in.a += e.begin;
+        g.code.push_back(in);
+    }
+    e.end = static_cast<uint32_t>(g.code.size());
+    e.maxStack = static_cast<uint32_t>(code.size());
+    g.exprs.push_back(e);
+    return static_cast<ExprId>(g.exprs.size() - 1);
+}
+
+TEST(FastCode, CodeTheMachineCannotRunStaysPlain) {
+    Graph g;
+    const ExprId two = addCode(g, {{Op::Const, 0, 0, 1}, {Op::Const, 0, 0, 2}});  // two values
+    const ExprId none = addCode(g, {});
+    const ExprId ok = addCode(g, {{Op::Const, 0, 0, 1}, {Op::Const, 0, 0, 2}, {Op::Sub}});
+    buildFastCode(g);
+    EXPECT_EQ(g.exprs[two].fast, kNoFast);
+    EXPECT_EQ(g.exprs[none].fast, kNoFast);
+    EXPECT_NE(g.exprs[ok].fast, kNoFast);
+    EXPECT_EQ(evalExpr(g, two, {nullptr, kRootPath}), 2.0);
+    EXPECT_TRUE(std::isnan(evalExpr(g, none, {nullptr, kRootPath})));
+    EXPECT_EQ(evalExpr(g, ok, {nullptr, kRootPath}), -1.0);
+    EXPECT_EQ(dumpFastExpr(g, two), "");
+}
+
+TEST(FastCode, SimultaneousCalcsReadTheIncomingFrame) {
+    Graph g;
+    const Slot a = g.slot("a"), b = g.slot("b");
+    // {a = b + 1; b = a * 10}, in order and together
+    const ExprId e1 = addCode(g, {{Op::Load, 0, b, 0}, {Op::Const, 0, 0, 1}, {Op::Add}});
+    const ExprId e2 = addCode(g, {{Op::Load, 0, a, 0}, {Op::Const, 0, 0, 10}, {Op::Mul}});
+    g.assignments = {{a, e1}, {b, e2}};
+    g.calcs.push_back(Calc{0, 2, false});
+    g.calcs.push_back(Calc{0, 2, true});
+    const NodeId ordered = g.addNode(NodeKind::Calc, 0, {});
+    const NodeId together = g.addNode(NodeKind::Calc, 1, {});
+    buildFastCode(g);
+    ASSERT_NE(g.calcs[0].fast, kNoFast);
+    ASSERT_NE(g.calcs[1].fast, kNoFast);
+    std::vector<double> in = {5, 1}, out(2);
+    applyCalc(g, ordered, {in.data(), kRootPath}, out.data());
+    EXPECT_EQ(out, (std::vector<double>{2, 20}));
+    applyCalc(g, together, {in.data(), kRootPath}, out.data());
+    EXPECT_EQ(out, (std::vector<double>{2, 50}));
+    EXPECT_EQ(in, (std::vector<double>{5, 1}));
+}
+
+TEST(FastCode, ChangingTheCodeDropsTheFastForm) {
+    auto c = withExprs({"x + 1"});
+    ASSERT_TRUE(c->graph);
+    Graph g = *c->graph;
+    EXPECT_FALSE(g.fastCode.empty());
+    dropFastCode(g);
+    EXPECT_TRUE(g.fastCode.empty());
+    for (const Expr& e : g.exprs) EXPECT_EQ(e.fast, kNoFast);
+    for (const Calc& k : g.calcs) EXPECT_EQ(k.fast, kNoFast);
+}
+
+}  // namespace
+}  // namespace pcsg
