@@ -65,8 +65,8 @@ size_t Graph::graphBytes() const {
     b += vectorBytes(files) + vectorBytes(nodes) + vectorBytes(edges) + vectorBytes(modules) +
          vectorBytes(transforms) + vectorBytes(calcs) + vectorBytes(assignments) +
          vectorBytes(primitives) + vectorBytes(args) + vectorBytes(exprs) + vectorBytes(code) +
-         vectorBytes(slotNames) + vectorBytes(materials) + vectorBytes(scene.lights) +
-         vectorBytes(timedValues);
+         vectorBytes(fastCode) + vectorBytes(slotNames) + vectorBytes(materials) +
+         vectorBytes(scene.lights) + vectorBytes(timedValues);
     for (const auto& f : files) b += stringBytes(f);
     for (const auto& m : modules)
         b += stringBytes(m.name) + vectorBytes(m.conditions) + vectorBytes(m.formals);
