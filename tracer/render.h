@@ -61,7 +61,7 @@ struct RenderOptions {
     std::shared_ptr<SequenceInstanceBoxes> sequenceBoxes;
     // Expanded instances (unrolled_instances.h), in one cache shared by the threads that
     // holds at most this many bytes; 0: none.
-    size_t expansionBytes = 128u << 20;
+    size_t expansionBytes = 16u << 20;
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
     // Called from worker threads after each tile of each pass (1, or 2 for adaptive

@@ -102,7 +102,7 @@ class TraceScene {
 
     // Expanded instances (unrolled_instances.h): one cache shared by all the tracers of
     // this scene (unroll_cache.h) holds at most this many bytes; 0 turns them off.
-    size_t expansionBytes = 128u << 20;
+    size_t expansionBytes = 16u << 20;
     // That cache, made by the first tracer that asks for it (with expansionBytes then).
     UnrollCache& expansionCache() const;
 

@@ -71,7 +71,7 @@ struct RenderCommandOptions {
     bool noBounds = false;
     bool noInstanceBoxes = false;
     size_t boxCacheMb = 64;
-    size_t expansionCacheMb = 128;
+    size_t expansionCacheMb = 16;
     uint64_t countVisits = 20'000'000;
     double clock = 0;  // --clock: the still's time
     int frame = 1;     // --frame: the still's frame number
