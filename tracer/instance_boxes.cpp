@@ -9,8 +9,8 @@
 #include <bit>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <optional>
+#include <stdexcept>
 #include <type_traits>
 #include <unordered_map>
 

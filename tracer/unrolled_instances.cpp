@@ -336,8 +336,9 @@ class Unroller {
 size_t UnrolledInstance::bytes() const {
     return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
-           matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) + choices_.capacity() * sizeof(uint32_t) +
-           bvh_.capacity() * sizeof(BvhNode) + links_.capacity() * sizeof(Link);
+           matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) +
+           choices_.capacity() * sizeof(uint32_t) + bvh_.capacity() * sizeof(BvhNode) +
+           links_.capacity() * sizeof(Link);
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
