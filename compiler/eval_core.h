@@ -4,7 +4,9 @@
 #pragma once
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "graph.h"
 
@@ -23,6 +25,9 @@ constexpr double toUnit(uint64_t h) {
 // rand(x) and rand() (eval.h's randOf and randAt), inline for the machines' loops.
 inline double randOfInline(uint64_t seed, double x) {
     if (x == 0) x = 0;  // -0 and +0 are the same argument
+    // So is every NaN: which NaN an operation gives (its sign, its payload) is up to the
+    // compiler, which may swap the operands of + and * (the sanitizer build does).
+    if (std::isnan(x)) x = std::numeric_limits<double>::quiet_NaN();
     const uint64_t bits = std::bit_cast<uint64_t>(x);
     return toUnit(mix64(mix64(bits ^ 0x3c6ef372fe94f82bULL) ^ mix64(seed + 0xa54ff53a5f1d36f1ULL)));
 }
