@@ -17,6 +17,7 @@ namespace pcsg::tracer {
 namespace {
 
 using testing::compile;
+using testing::expectSameBoxes;
 
 // Systems whose instances differ a lot: parameter-dependent rotations and scales, CSG,
 // random heights (rand(x) and rand()), choose().
@@ -196,39 +197,6 @@ TEST(InstanceBoxes, TheBoxDoesNotDependOnWhatTheCacheHeld) {
         EXPECT_GT(warm.stats().entries, 0u);
         EXPECT_TRUE(first.isBounded());
     }
-}
-
-// Every S-node instance's box from `a` and from `b` (recursively: small systems only).
-void expectSameBoxes(const Graph& g, const InstanceBoxes& a, const InstanceBoxes& b) {
-    auto wa = a.makeWorker(), wb = b.makeWorker();
-    size_t checks = 0;
-    auto walk = [&](auto&& self, NodeId n, const std::vector<double>& frame, uint64_t path,
-                    uint32_t depth) -> void {
-        const Node& node = g.nodes[n];
-        const EvalState st{frame.data(), path};
-        if (node.kind == NodeKind::Select) {
-            ++depth;
-            ++checks;
-            EXPECT_EQ(a.box(*wa, n, depth, frame.data(), path),
-                      b.box(*wb, n, depth, frame.data(), path));
-            const uint32_t r = selectRule(g, n, st);
-            return self(self, g.child(n, r), frame, pathRule(path, r), depth);
-        }
-        if (node.kind == NodeKind::Calc) {
-            std::vector<double> next(g.slotCount());
-            applyCalc(g, n, st, next.data());
-            return self(self, g.child(n), next, path, depth);
-        }
-        if (node.kind == NodeKind::Operator)
-            for (uint32_t i = 0; i < node.childCount; ++i)
-                self(self, g.child(n, i), frame, pathChild(path, i), depth);
-        if (node.kind == NodeKind::Transform || node.kind == NodeKind::Paint)
-            self(self, g.child(n), frame, path, depth);
-    };
-    std::vector<double> frame(g.slotCount());
-    initFrame(g, frame.data());
-    walk(walk, g.axiom, frame, kRootPath, 0);
-    EXPECT_GT(checks, 0u);
 }
 
 TEST(InstanceBoxes, FillingAheadStoresTheBoxesTheMissesWouldCompute) {

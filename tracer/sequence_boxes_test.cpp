@@ -17,6 +17,7 @@ namespace pcsg::tracer {
 namespace {
 
 using testing::compile;
+using testing::expectSameBoxes;
 
 // F reads no time (only the transform above it moves with the clock; 243 spheres, so that
 // its instances are large enough for the render to store: InstanceBoxOptions::minWeight);
@@ -42,40 +43,6 @@ InstanceBoxOptions always(std::shared_ptr<SequenceInstanceBoxes> sequence = null
     o.minWeight = 1;
     o.sequence = std::move(sequence);
     return o;
-}
-
-// Every S-node instance's box from `a` and from `b`; returns how many were compared.
-size_t expectSameBoxes(const Graph& g, const InstanceBoxes& a, const InstanceBoxes& b) {
-    auto wa = a.makeWorker(), wb = b.makeWorker();
-    size_t checks = 0;
-    auto walk = [&](auto&& self, NodeId n, const std::vector<double>& frame, uint64_t path,
-                    uint32_t depth) -> void {
-        const Node& node = g.nodes[n];
-        const EvalState st{frame.data(), path};
-        if (node.kind == NodeKind::Select) {
-            ++depth;
-            ++checks;
-            EXPECT_EQ(a.box(*wa, n, depth, frame.data(), path),
-                      b.box(*wb, n, depth, frame.data(), path))
-                << "module " << g.modules[node.payload].name << " at depth " << depth;
-            const uint32_t r = selectRule(g, n, st);
-            return self(self, g.child(n, r), frame, pathRule(path, r), depth);
-        }
-        if (node.kind == NodeKind::Calc) {
-            std::vector<double> next(g.slotCount());
-            applyCalc(g, n, st, next.data());
-            return self(self, g.child(n), next, path, depth);
-        }
-        if (node.kind == NodeKind::Operator)
-            for (uint32_t i = 0; i < node.childCount; ++i)
-                self(self, g.child(n, i), frame, pathChild(path, i), depth);
-        if (node.kind == NodeKind::Transform || node.kind == NodeKind::Paint)
-            self(self, g.child(n), frame, path, depth);
-    };
-    std::vector<double> frame(g.slotCount());
-    initFrame(g, frame.data());
-    walk(walk, g.axiom, frame, kRootPath, 0);
-    return checks;
 }
 
 TEST(SequenceBoxes, ALaterFrameFindsTheTimeFreeBoxesAndComputesTheOthers) {

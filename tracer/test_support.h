@@ -12,6 +12,7 @@
 
 #include "compiler.h"
 #include "eval.h"
+#include "instance_boxes.h"
 
 namespace pcsg::tracer::testing {
 
@@ -110,6 +111,66 @@ class Expander {
         path_.pop_back();
     }
 };
+
+// Expand wherever an instance is met a second time, from the first instance on.
+inline InstanceBoxOptions eagerExpansion() {
+    InstanceBoxOptions o;
+    o.trial = 1;
+    o.minExpandWeight = 1;
+    o.maxUnrollWeight = 1u << 20;
+    return o;
+}
+
+// A branching plant n levels deep: paints, choose(), rand(), CSG leaves, a shear.
+inline std::string branchingPlant(int n) {
+    return R"(
+material bark { color <0.4, 0.3, 0.2> }
+material leaf { color <0.2, 0.6, 0.1>  phong 0.3 }
+settings { seed 3 }
+{n = )" + std::to_string(n) +
+           R"(; a = 35} P
+P if(n > 0, choose(0.7, 0.3) + 1, 1)
+1: P -> paint(leaf) (move(0,0,0.3) scale(0.3,0.1,0.3) sphere ∩ cylinder)
+2: P -> paint(bark) scale(0.1,0.1,1) cylinder ∪
+        {n = n-1} move(0,0,1) rotz(rand()*360) (rotx(a) uscale(0.7) P ∪ roty(-a) uscale(0.6) P)
+3: P -> torus(0.5, 0.1) ∪ {n = n-1} move(0,0,0.2) zshear(0.2, 0.1) flipxz uscale(0.8) P
+)";
+}
+
+// Every S-node instance's box from `a` and from `b`, following the derivation from the
+// axiom (recursively: small systems only); returns how many were compared.
+inline size_t expectSameBoxes(const Graph& g, const InstanceBoxes& a, const InstanceBoxes& b) {
+    auto wa = a.makeWorker(), wb = b.makeWorker();
+    size_t checks = 0;
+    auto walk = [&](auto&& self, NodeId n, const std::vector<double>& frame, uint64_t path,
+                    uint32_t depth) -> void {
+        const Node& node = g.nodes[n];
+        const EvalState st{frame.data(), path};
+        if (node.kind == NodeKind::Select) {
+            ++depth;
+            ++checks;
+            EXPECT_EQ(a.box(*wa, n, depth, frame.data(), path),
+                      b.box(*wb, n, depth, frame.data(), path))
+                << "module " << g.modules[node.payload].name << " at depth " << depth;
+            const uint32_t r = selectRule(g, n, st);
+            return self(self, g.child(n, r), frame, pathRule(path, r), depth);
+        }
+        if (node.kind == NodeKind::Calc) {
+            std::vector<double> next(g.slotCount());
+            applyCalc(g, n, st, next.data());
+            return self(self, g.child(n), next, path, depth);
+        }
+        if (node.kind == NodeKind::Operator)
+            for (uint32_t i = 0; i < node.childCount; ++i)
+                self(self, g.child(n, i), frame, pathChild(path, i), depth);
+        if (node.kind == NodeKind::Transform || node.kind == NodeKind::Paint)
+            self(self, g.child(n), frame, path, depth);
+    };
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    walk(walk, g.axiom, frame, kRootPath, 0);
+    return checks;
+}
 
 // A few systems from the paper and beyond, shared by the tests.
 inline const char* kSierpinski = R"(

@@ -17,15 +17,7 @@ namespace pcsg::tracer {
 namespace {
 
 using testing::compile;
-
-// Expand wherever an instance is met a second time, from the first instance on.
-InstanceBoxOptions eager() {
-    InstanceBoxOptions o;
-    o.trial = 1;
-    o.minExpandWeight = 1;
-    o.maxUnrollWeight = 1u << 20;
-    return o;
-}
+using testing::eagerExpansion;
 
 // A flower head of p petals: each value of p is an instance of its own.
 const char* kFlower = R"(
@@ -37,17 +29,7 @@ F if(p > 0, 2, 1)
         {p = p-1} rotz(360/21) F
 )";
 
-const char* kPlant = R"(
-material bark { color <0.4, 0.3, 0.2> }
-material leaf { color <0.2, 0.6, 0.1>  phong 0.3 }
-settings { seed 3 }
-{n = 6; a = 35} P
-P if(n > 0, choose(0.7, 0.3) + 1, 1)
-1: P -> paint(leaf) (move(0,0,0.3) scale(0.3,0.1,0.3) sphere ∩ cylinder)
-2: P -> paint(bark) scale(0.1,0.1,1) cylinder ∪
-        {n = n-1} move(0,0,1) rotz(rand()*360) (rotx(a) uscale(0.7) P ∪ roty(-a) uscale(0.6) P)
-3: P -> torus(0.5, 0.1) ∪ {n = n-1} move(0,0,0.2) zshear(0.2, 0.1) flipxz uscale(0.8) P
-)";
+const std::string kPlant = testing::branchingPlant(6);
 
 // The flower's S-node and the frame of its instance with p petals.
 struct Flower {
@@ -81,7 +63,7 @@ Hit hitOf(const UnrolledInstance& x, UnrollCache::Reader& r) {
 TEST(UnrollCache, ThreadsAskingForOneInstanceGetOneObjectBuiltOnce) {
     auto c = compile(kFlower);
     ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
     UnrollCache cache(scene, 64u << 20);
     constexpr int kThreads = 4;
     std::vector<const UnrolledInstance*> got(kThreads, nullptr);
@@ -105,7 +87,7 @@ TEST(UnrollCache, ThreadsAskingForOneInstanceGetOneObjectBuiltOnce) {
 TEST(UnrollCache, AnInstanceEvictedWhileInUseStaysIntactUntilItsReaderUnpins) {
     auto c = compile(kFlower);
     ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
     UnrollCache cache(scene, 2048);  // room for notes and small instances
     Flower fa(*c->graph), fb(*c->graph);
     ASSERT_NE(fa.slot, SIZE_MAX);
@@ -140,9 +122,9 @@ TEST(UnrollCache, TracersOnSeveralThreadsStayWithinOneBudgetAndFindTheGraphWalks
     auto c = compile(kPlant);
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
-    TraceScene plain(g, computeBounds(g), true, eager());
+    TraceScene plain(g, computeBounds(g), true, eagerExpansion());
     plain.expansionBytes = 0;
-    TraceScene shared(g, computeBounds(g), true, eager());
+    TraceScene shared(g, computeBounds(g), true, eagerExpansion());
     shared.expansionBytes = 24 * 1024;
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);

@@ -15,27 +15,9 @@ namespace pcsg::tracer {
 namespace {
 
 using testing::compile;
+using testing::eagerExpansion;
 
-// Expand wherever an instance is met a second time, from the first instance on.
-InstanceBoxOptions eager() {
-    InstanceBoxOptions o;
-    o.trial = 1;
-    o.minExpandWeight = 1;
-    o.maxUnrollWeight = 1u << 20;
-    return o;
-}
-
-const char* kPlant = R"(
-material bark { color <0.4, 0.3, 0.2> }
-material leaf { color <0.2, 0.6, 0.1>  phong 0.3 }
-settings { seed 3 }
-{n = 5; a = 35} P
-P if(n > 0, choose(0.7, 0.3) + 1, 1)
-1: P -> paint(leaf) (move(0,0,0.3) scale(0.3,0.1,0.3) sphere ∩ cylinder)
-2: P -> paint(bark) scale(0.1,0.1,1) cylinder ∪
-        {n = n-1} move(0,0,1) rotz(rand()*360) (rotx(a) uscale(0.7) P ∪ roty(-a) uscale(0.6) P)
-3: P -> torus(0.5, 0.1) ∪ {n = n-1} move(0,0,0.2) zshear(0.2, 0.1) flipxz uscale(0.8) P
-)";
+const std::string kPlant = testing::branchingPlant(5);
 
 // CSG around S-nodes: recursive operands of ∩ and \, a plane, triangles in unions.
 const char* kCsg = R"(
@@ -94,9 +76,9 @@ uint64_t compareWithGraphWalk(const char* text, const Rays& r, int minHits) {
     EXPECT_TRUE(c->graph);
     if (!c->graph) return 0;
     const Graph& g = *c->graph;
-    TraceScene plain(g, computeBounds(g), true, eager());
+    TraceScene plain(g, computeBounds(g), true, eagerExpansion());
     plain.expansionBytes = 0;
-    TraceScene expanding(g, computeBounds(g), true, eager());
+    TraceScene expanding(g, computeBounds(g), true, eagerExpansion());
     Tracer a(plain), b(expanding);
     int hits = 0;
     for (int round = 0; round < 2; ++round)
@@ -122,7 +104,7 @@ uint64_t compareWithGraphWalk(const char* text, double spread, int minHits = 200
 }
 
 TEST(ExpandedInstances, PlantsHitTheSameSurfacesBitForBit) {
-    EXPECT_GT(compareWithGraphWalk(kPlant, 1.5), 0u);
+    EXPECT_GT(compareWithGraphWalk(kPlant.c_str(), 1.5), 0u);
 }
 
 TEST(ExpandedInstances, CsgAroundSNodesHitsTheSameSurfacesBitForBit) {
@@ -171,7 +153,7 @@ TEST(ExpandedInstances, AChainOfUnionsGetsAHierarchyAndTheSameHits) {
     auto c = compile(kChain);
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
-    TraceScene scene(g, computeBounds(g), true, eager());
+    TraceScene scene(g, computeBounds(g), true, eagerExpansion());
     UnrollCache cache(scene, 1u << 20);
     UnrollCache::Reader reader(cache);
     const UnrollCache::Pin pin(&reader);
@@ -190,7 +172,7 @@ TEST(ExpandedInstances, AChainOfUnionsGetsAHierarchyAndTheSameHits) {
 TEST(ExpandedInstances, TheCacheStaysWithinItsBudget) {
     auto c = compile(kPlant);
     ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
     scene.expansionBytes = 8 * 1024;
     Tracer t(scene);
     const Rays r = rays(2000, 11, 1.5);
@@ -217,7 +199,7 @@ S if(n > 0, 2, 1)
 2: S -> {n = n-1} (uscale(0.9) S ∪ move(0,0,2) cube)
 )");
     ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eager());
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
     Tracer t(scene);
     const Rays r = rays(50, 5, 0.5);
     bool thrown = false;
