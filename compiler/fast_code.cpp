@@ -54,36 +54,6 @@ struct CodeShape {
     int maxDepth = 0;
 };
 
-bool stackEffect(const Instr& in, int& need, int& change) {
-    need = 0, change = 0;
-    switch (in.op) {
-        case Op::Const:
-        case Op::Load:
-        case Op::Rand0:
-        case Op::Clock:
-        case Op::Frame:
-            change = 1;
-            return true;
-        case Op::Neg:
-        case Op::Not:
-        case Op::ToBool:
-            need = 1;
-            return true;
-        case Op::Jump:
-            return true;
-        case Op::JumpIfZero:
-            need = 1, change = -1;
-            return true;
-        case Op::Call:
-        case Op::Choose:
-            need = in.argc, change = 1 - in.argc;
-            return in.argc >= 1;
-        default:
-            need = 2, change = -1;
-            return isBinary(in.op);
-    }
-}
-
 bool shapeOf(const Graph& g, uint32_t begin, uint32_t end, CodeShape& s) {
     const uint32_t n = end - begin;
     s.depth.assign(n + 1, -1);
@@ -291,6 +261,36 @@ std::string dumpFrom(const Graph& g, uint32_t start) {
 }
 
 }  // namespace
+
+bool stackEffect(const Instr& in, int& need, int& change) {
+    need = 0, change = 0;
+    switch (in.op) {
+        case Op::Const:
+        case Op::Load:
+        case Op::Rand0:
+        case Op::Clock:
+        case Op::Frame:
+            change = 1;
+            return true;
+        case Op::Neg:
+        case Op::Not:
+        case Op::ToBool:
+            need = 1;
+            return true;
+        case Op::Jump:
+            return true;
+        case Op::JumpIfZero:
+            need = 1, change = -1;
+            return true;
+        case Op::Call:
+        case Op::Choose:
+            need = in.argc, change = 1 - in.argc;
+            return in.argc >= 1;
+        default:
+            need = 2, change = -1;
+            return isBinary(in.op);
+    }
+}
 
 void dropFastCode(Graph& g) {
     g.fastCode.clear();

@@ -16,6 +16,12 @@ namespace pcsg {
 // Translates every expression and C-node of g (replacing any fast form there was). Code the
 // fast machine cannot run (a stack deeper than kFastStack, a backward jump, code that
 // does not leave exactly one value: only hand-made code) keeps running plain.
+// A plain instruction's effect on the stack: the values it needs on it and the change of
+// its depth; false for an instruction that cannot be well formed (a call without
+// arguments, an unknown operator). Shared by the translation and the parser fuzzer's
+// graph checks.
+bool stackEffect(const Instr& in, int& need, int& change);
+
 void buildFastCode(Graph& g);
 
 // Forgets the fast form: every expression and C-node runs the plain code again.

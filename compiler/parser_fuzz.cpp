@@ -22,6 +22,7 @@
 
 #include "compiler.h"
 #include "eval.h"
+#include "fast_code.h"
 
 namespace {
 
@@ -44,39 +45,10 @@ void checkStack(const Graph& g, const Expr& e) {
         const int d = depthAt[i];
         if (d < 0) continue;  // unreachable
         const Instr& in = g.code[e.begin + i];
-        int next = d;
-        uint32_t target = kNone;
-        switch (in.op) {
-            case Op::Const:
-            case Op::Load:
-            case Op::Rand0:
-            case Op::Clock:
-            case Op::Frame:
-                next = d + 1;
-                break;
-            case Op::Neg:
-            case Op::Not:
-            case Op::ToBool:
-                check(d >= 1, "unary on empty stack");
-                break;
-            case Op::Jump:
-                target = in.a;
-                break;
-            case Op::JumpIfZero:
-                check(d >= 1, "branch on empty stack");
-                next = d - 1;
-                target = in.a;
-                break;
-            case Op::Call:
-            case Op::Choose:
-                check(d >= in.argc && in.argc >= 1, "call without its arguments");
-                next = d - in.argc + 1;
-                break;
-            default:
-                check(d >= 2, "binary on a short stack");
-                next = d - 1;
-                break;
-        }
+        int need = 0, change = 0;
+        check(stackEffect(in, need, change) && d >= need, "an instruction without its operands");
+        const int next = d + change;
+        const uint32_t target = in.op == Op::Jump || in.op == Op::JumpIfZero ? in.a : kNone;
         check(next <= static_cast<int>(e.maxStack), "stack deeper than maxStack");
         if (target != kNone) {
             check(target > e.begin + i && target <= e.end,
