@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "adaptive_encode.h"
 #include "bounds.h"
 #include "camera.h"
 #include "eval.h"
@@ -69,23 +70,13 @@ double threadCpuSeconds() {
     return static_cast<double>(ts.tv_sec) + ts.tv_nsec * 1e-9;
 }
 
-double aaEncode(double c) {
-    return c > 0 ? std::pow(c, 1.0 / 2.5) : 0.0;
-}
-
-// The distance of two pixels' colours already encoded by aaEncode.
-double colourDistance(const double* a, const double* b) {
-    double d = 0;
-    for (int k = 0; k < 3; ++k) d += std::fabs(a[k] - b[k]);
-    return d;
-}
-
 struct Worker {
     explicit Worker(const TraceScene& s) : shader(s) {}
     Shader shader;
     // Adaptive sampling: the pass-1 colours of the tile being supersampled and of its
     // border, encoded by aaEncode (`pass` names the pass they belong to).
     std::vector<double> encoded;
+    AaEncodeMemo encode;
     Region tile{0, 0, 0, 0}, area{0, 0, 0, 0};
     uint64_t pass = 0;
 };
@@ -248,7 +239,7 @@ class TileRender {
             double* e = wk.encoded.data();
             for (int v = wk.area.y0; v < wk.area.y1; ++v) {
                 const float* c = pixelAt(centres, wk.area.x0, v);
-                for (int k = 0; k < wk.area.width() * 3; ++k) *e++ = aaEncode(c[k]);
+                for (int k = 0; k < wk.area.width() * 3; ++k) *e++ = wk.encode(c[k]);
             }
         }
         return wk.encoded.data();
