@@ -1,10 +1,10 @@
 // The PNG files of a frame sequence (`pcsg render --frames N`), each encoded on a thread of
 // its own while the next frame renders: libpng's filters and zlib take one thread some
 // 120 M instructions a 640x480 frame (30 ms), during which the render's other threads
-// used to wait. The pixels are turned into 8-bit sRGB values (png_writer.h's srgbBytes)
-// before the hand-over, so what waits is 0.9 MB of bytes, not the 3.7 MB of floats; and
-// one file at a time is written: the next is handed over only once the last is done.
-// The files are byte for byte those writePng() writes.
+// used to wait. The pixels are turned into 8-bit sRGB values (png_writer.h's srgbBytes, in
+// parallel) before the hand-over, so what waits is 0.9 MB of bytes, not the 3.7 MB of
+// floats; and one file at a time is written: the next is handed over only once the last
+// is done. The files are byte for byte those writePng() writes.
 #pragma once
 
 #include <cstdint>
@@ -25,7 +25,8 @@ class FrameWriter {
         double seconds = 0;
     };
 
-    FrameWriter() = default;
+    // `threads`: how many convert the pixels (the render's --threads; 0: all cores).
+    explicit FrameWriter(int threads = 0) : threads_(threads) {}
     ~FrameWriter();  // waits for the write in progress
     FrameWriter(const FrameWriter&) = delete;
     FrameWriter& operator=(const FrameWriter&) = delete;
@@ -40,6 +41,7 @@ class FrameWriter {
     std::optional<Written> done();
 
   private:
+    int threads_;
     std::future<Written> pending_;
 };
 

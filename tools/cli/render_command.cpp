@@ -651,7 +651,7 @@ int runFrames(const RenderCommandOptions& o, const FramePlan& plan, CompiledScen
     const bool showProgress = isatty(STDERR_FILENO) != 0;
     // Frame f renders while frame f-1's PNG is written; a failed write of f-1 is reported
     // after f's render (and its error, if it had one) and ends the sequence.
-    FrameWriter writer;
+    FrameWriter writer(o.threads);
     std::optional<FrameFigures> last;
     for (int f = plan.first; f <= plan.last; ++f) {
         FrameFigures figures;
