@@ -73,8 +73,8 @@ double threadCpuSeconds() {
 struct Worker {
     explicit Worker(const TraceScene& s) : shader(s) {}
     Shader shader;
-    // Adaptive sampling: the pass-1 colours of the tile being supersampled and of its
-    // border, encoded by aaEncode (`pass` names the pass they belong to).
+    // Adaptive sampling: the pass-1 colours of the tile being decided and of its border,
+    // encoded by aaEncode through `encode` (`pass` names the pass they belong to).
     std::vector<double> encoded;
     AaEncodeMemo encode;
     Region tile{0, 0, 0, 0}, area{0, 0, 0, 0};
@@ -237,7 +237,7 @@ class TileRender {
 
     // The pass-1 colours encoded by aaEncode (each pixel is compared with up to four
     // neighbours): once per pixel of the tile of (x, y) and its border, kept by the worker
-    // while it supersamples that tile (a few KB, not a copy of the image).
+    // while it decides that tile's pixels (a few KB, not a copy of the image).
     const double* encodedTile(Worker& wk, uint64_t pass, int x, int y) const {
         const Region& t = wk.tile;
         if (wk.pass != pass || x < t.x0 || x >= t.x1 || y < t.y0 || y >= t.y1) {
