@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "adaptive_encode.h"
 #include "bounds.h"
 #include "camera.h"
 #include "eval.h"
@@ -69,23 +70,13 @@ double threadCpuSeconds() {
     return static_cast<double>(ts.tv_sec) + ts.tv_nsec * 1e-9;
 }
 
-double aaEncode(double c) {
-    return c > 0 ? std::pow(c, 1.0 / 2.5) : 0.0;
-}
-
-// The distance of two pixels' colours already encoded by aaEncode.
-double colourDistance(const double* a, const double* b) {
-    double d = 0;
-    for (int k = 0; k < 3; ++k) d += std::fabs(a[k] - b[k]);
-    return d;
-}
-
 struct Worker {
     explicit Worker(const TraceScene& s) : shader(s) {}
     Shader shader;
-    // Adaptive sampling: the pass-1 colours of the tile being supersampled and of its
-    // border, encoded by aaEncode (`pass` names the pass they belong to).
+    // Adaptive sampling: the pass-1 colours of the tile being decided and of its border,
+    // encoded by aaEncode through `encode` (`pass` names the pass they belong to).
     std::vector<double> encoded;
+    AaEncodeMemo encode;
     Region tile{0, 0, 0, 0}, area{0, 0, 0, 0};
     uint64_t pass = 0;
 };
@@ -131,10 +122,16 @@ class TileRender {
         first();
         forTiles(1, halo_, [&](Worker& wk, int x, int y) { samplePixel(wk, x, y); });
         if (opt_.adaptive > 0 && !stop_) {
-            const std::vector<float> centres = rgb_;
+            // Which pixels differ from a neighbour, decided on pass 1's centres before pass 2
+            // overwrites any (a byte a pixel, where a copy of the centres took 12).
             const uint64_t pass = ++adaptivePasses;
-            forTiles(2, region_,
-                     [&](Worker& wk, int x, int y) { supersamplePixel(wk, centres, pass, x, y); });
+            std::vector<uint8_t> differs(region_.pixels());
+            forTiles(kDecide, region_, [&](Worker& wk, int x, int y) {
+                differs[regionIndex(x, y)] = differsFromNeighbour(wk, pass, x, y);
+            });
+            forTiles(2, region_, [&](Worker& wk, int x, int y) {
+                if (differs[regionIndex(x, y)]) supersamplePixel(wk, x, y);
+            });
         }
         if (firstError_) std::rethrow_exception(firstError_);
         if (stop_) throw RenderCancelled();
@@ -142,6 +139,9 @@ class TileRender {
     }
 
   private:
+    // The decision between the passes: not a pass of its own for tileTime and progress.
+    static constexpr int kDecide = 0;
+
     static int tileCount(const Region& r) {
         return ((r.width() + kTile - 1) / kTile) * ((r.height() + kTile - 1) / kTile);
     }
@@ -197,10 +197,15 @@ class TileRender {
             stop_ = true;
             return false;
         }
+        if (pass == kDecide) return true;
         if (opt_.tileTime) opt_.tileTime(pass, t.x0, t.y0, t.x1, t.y1, threadCpuSeconds() - start);
         const int d = ++done_;
         if (opt_.progress) opt_.progress(static_cast<double>(d) / totalWork_);
         return true;
+    }
+
+    size_t regionIndex(int x, int y) const {
+        return static_cast<size_t>(y - region_.y0) * region_.width() + (x - region_.x0);
     }
 
     // Pixel (x, y) of the image in the buffer, which holds halo_.
@@ -232,9 +237,8 @@ class TileRender {
 
     // The pass-1 colours encoded by aaEncode (each pixel is compared with up to four
     // neighbours): once per pixel of the tile of (x, y) and its border, kept by the worker
-    // while it supersamples that tile (a few KB, not a copy of the image).
-    const double* encodedTile(Worker& wk, const std::vector<float>& centres, uint64_t pass, int x,
-                              int y) const {
+    // while it decides that tile's pixels (a few KB, not a copy of the image).
+    const double* encodedTile(Worker& wk, uint64_t pass, int x, int y) const {
         const Region& t = wk.tile;
         if (wk.pass != pass || x < t.x0 || x >= t.x1 || y < t.y0 || y >= t.y1) {
             const int x0 = region_.x0 + (x - region_.x0) / kTile * kTile;
@@ -247,30 +251,33 @@ class TileRender {
             wk.encoded.resize(wk.area.pixels() * 3);
             double* e = wk.encoded.data();
             for (int v = wk.area.y0; v < wk.area.y1; ++v) {
-                const float* c = pixelAt(centres, wk.area.x0, v);
-                for (int k = 0; k < wk.area.width() * 3; ++k) *e++ = aaEncode(c[k]);
+                const float* c = pixelAt(rgb_, wk.area.x0, v);
+                for (int k = 0; k < wk.area.width() * 3; ++k) *e++ = wk.encode(c[k]);
             }
         }
         return wk.encoded.data();
     }
 
-    // Pass 2 of adaptive sampling (POV-Ray's +A, method 1): a pixel whose centre differs
-    // from a 4-neighbour's by the threshold or more gets depth x depth more samples.
-    void supersamplePixel(Worker& wk, const std::vector<float>& centres, uint64_t pass, int x,
-                          int y) {
-        const float* c = pixelAt(centres, x, y);
-        const double* encoded = encodedTile(wk, centres, pass, x, y);
+    // Adaptive sampling (POV-Ray's +A, method 1): whether pixel (x, y)'s centre differs
+    // from a 4-neighbour's by the threshold or more. Reads pass 1's centres.
+    bool differsFromNeighbour(Worker& wk, uint64_t pass, int x, int y) const {
+        const double* encoded = encodedTile(wk, pass, x, y);
         auto at = [&](int px, int py) {  // (the neighbours of the tile's pixels are in area)
             return encoded +
                    (static_cast<size_t>(py - wk.area.y0) * wk.area.width() + (px - wk.area.x0)) * 3;
         };
-        bool differs = false;
         const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-        for (int k = 0; k < 4 && !differs; ++k) {
+        for (int k = 0; k < 4; ++k) {
             if (nx[k] < 0 || nx[k] >= w_ || ny[k] < 0 || ny[k] >= h_) continue;
-            differs = colourDistance(at(x, y), at(nx[k], ny[k])) >= opt_.adaptive;
+            if (colourDistance(at(x, y), at(nx[k], ny[k])) >= opt_.adaptive) return true;
         }
-        if (!differs) return;
+        return false;
+    }
+
+    // Pass 2 of adaptive sampling, where a pixel differs: depth x depth more samples,
+    // averaged with its centre (which only this pixel reads now).
+    void supersamplePixel(Worker& wk, int x, int y) {
+        const float* c = pixelAt(rgb_, x, y);
         const int depth = std::max(1, opt_.adaptiveDepth);
         const double step = 1.0 / depth, range = 0.5 - step * 0.5;
         Vec3 sum{c[0], c[1], c[2]};

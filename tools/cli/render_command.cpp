@@ -44,6 +44,7 @@
 #include "distributed_render.h"
 #include "eval.h"
 #include "expander.h"
+#include "frame_writer.h"
 #include "frames.h"
 #include "image_format.h"
 #include "image_helper.h"
@@ -436,14 +437,20 @@ class SequenceBounds {
     double seconds_ = 0;
 };
 
-// Sets frame f's time, renders it and writes its file, as a still at that clock would be.
+// The note a frame's errors end with.
+std::string frameNote(const FramePlan& plan, int f, double clock) {
+    return fmt::format("\n  at frame {} of {}, clock {}", f, plan.frames, clock);
+}
+
+// Sets frame f's time and renders it, as a still at that clock would be (report: its
+// pixels and figures; writeFrame writes them).
 int renderFrame(const RenderCommandOptions& o, const FramePlan& plan, int f, Graph& g,
-                const std::string& imageHelper, SequenceBounds& bounds,
-                const std::shared_ptr<ProgressBar>& bar, FrameFigures& out) {
+                SequenceBounds& bounds, const std::shared_ptr<ProgressBar>& bar, FrameFigures& out,
+                RenderReport& report) {
     out.frame = f;
     out.clock = frameClock(plan, f);
-    const std::string note =
-        fmt::format("\n  at frame {} of {}, clock {}", f, plan.frames, out.clock);
+    out.output = frameFileName(o.output, f, plan.frames);
+    const std::string note = frameNote(plan, f, out.clock);
     try {
         setTime(g, Time{out.clock, f});
     } catch (const RuntimeError& e) {
@@ -451,8 +458,7 @@ int renderFrame(const RenderCommandOptions& o, const FramePlan& plan, int f, Gra
         return 1;
     }
     RenderCommandOptions fo = o;
-    fo.output = frameFileName(o.output, f, plan.frames);
-    RenderReport report;
+    fo.output = out.output;
     const int count = plan.last - plan.first + 1;
     const FrameContext context{
         note,       bounds.next(), bounds.instanceBoxes(), bar, double(f - plan.first) / count,
@@ -460,17 +466,52 @@ int renderFrame(const RenderCommandOptions& o, const FramePlan& plan, int f, Gra
     if (const int status = countAndRender(g, fo, report, context)) return status;
     out.ownBounds = context.bounds == nullptr;
     bounds.update(report.result, out.ownBounds);
-    if (const std::string error = writeOutput(fo, imageHelper, report); !error.empty()) {
-        std::cerr << "pcsg render: " << error << note << "\n";
-        return 2;
-    }
-    // Releases the pixels: `= {}` would clear them but keep their memory, a whole image
-    // per frame held to the end of the sequence.
-    report.result.rgb = std::vector<float>();
-    out.output = fo.output;
-    out.result = std::move(report.result);
-    out.imageWriteSeconds = report.imageWriteSeconds;
     if (report.count.complete) out.primitives = report.count.primitives;
+    return 0;
+}
+
+// Writes the rendered frame's file: a PNG on the writer's thread (collected by
+// collectFrame), another format here. Releases the pixels either way: `= {}` would clear
+// them but keep their memory, a whole image per frame held to the end of the sequence.
+int writeFrame(const RenderCommandOptions& o, const FramePlan& plan, const std::string& imageHelper,
+               FrameWriter& writer, RenderReport& report, FrameFigures& out) {
+    if (imageFormatOf(out.output) == ImageFormat::png) {
+        writer.start(out.output, o.width, o.height, report.result.rgb);
+    } else {
+        RenderCommandOptions fo = o;
+        fo.output = out.output;
+        if (const std::string error = writeOutput(fo, imageHelper, report); !error.empty()) {
+            std::cerr << "pcsg render: " << error << frameNote(plan, out.frame, out.clock) << "\n";
+            return 2;
+        }
+        out.imageWriteSeconds = report.imageWriteSeconds;
+    }
+    report.result.rgb = std::vector<float>();
+    out.result = std::move(report.result);
+    return 0;
+}
+
+// The frame last handed to writeFrame, once its file is written (waiting for the writer's
+// thread): printed and added to `done`. 2 when its PNG could not be written.
+int collectFrame(const RenderCommandOptions& o, const FramePlan& plan, FrameWriter& writer,
+                 std::optional<FrameFigures>& last, std::vector<FrameFigures>& done) {
+    if (!last) return 0;
+    FrameFigures figures = std::move(*last);
+    last.reset();
+    if (const auto written = writer.done()) {
+        if (!written->error.empty()) {
+            std::cerr << "pcsg render: " << written->error
+                      << frameNote(plan, figures.frame, figures.clock) << "\n";
+            return 2;
+        }
+        figures.imageWriteSeconds = written->seconds;
+    }
+    if (!o.json)
+        std::cout << fmt::format("frame {} of {} (clock {}): wrote {} in {:.3f} s, {} rays\n",
+                                 figures.frame, plan.frames, figures.clock, figures.output,
+                                 figures.result.seconds, figures.result.rays)
+                  << std::flush;
+    done.push_back(std::move(figures));
     return 0;
 }
 
@@ -608,18 +649,21 @@ int runFrames(const RenderCommandOptions& o, const FramePlan& plan, CompiledScen
     // One bar over the whole sequence, cleared while a frame's line is printed.
     auto bar = std::make_shared<ProgressBar>();
     const bool showProgress = isatty(STDERR_FILENO) != 0;
+    // Frame f renders while frame f-1's PNG is written; a failed write of f-1 is reported
+    // after f's render (and its error, if it had one) and ends the sequence.
+    FrameWriter writer(o.threads);
+    std::optional<FrameFigures> last;
     for (int f = plan.first; f <= plan.last; ++f) {
         FrameFigures figures;
-        const int status = renderFrame(o, plan, f, g, imageHelper, bounds, bar, figures);
+        RenderReport report;
+        int status = renderFrame(o, plan, f, g, bounds, bar, figures, report);
         if (showProgress) bar->finish();
+        if (const int written = collectFrame(o, plan, writer, last, done)) return written;
+        if (status == 0) status = writeFrame(o, plan, imageHelper, writer, report, figures);
         if (status) return status;
-        if (!o.json)
-            std::cout << fmt::format("frame {} of {} (clock {}): wrote {} in {:.3f} s, {} rays\n",
-                                     f, plan.frames, figures.clock, figures.output,
-                                     figures.result.seconds, figures.result.rays)
-                      << std::flush;
-        done.push_back(std::move(figures));
+        last = std::move(figures);
     }
+    if (const int written = collectFrame(o, plan, writer, last, done)) return written;
     printFrames(o, plan, g, compiled, done, bounds.seconds());
     return 0;
 }

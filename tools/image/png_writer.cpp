@@ -127,16 +127,19 @@ std::vector<uint8_t> srgbBytes(std::span<const float> rgb) {
 }
 
 void writePng(const std::string& path, int width, int height, std::span<const float> rgb) {
+    writePngBytes(path, width, height, srgbBytes(rgb));
+}
+
+void writePngBytes(const std::string& path, int width, int height, std::span<const uint8_t> bytes) {
     auto fail = [&](const std::string& why) {
         throw std::runtime_error(fmt::format("cannot write '{}': {}", path, why));
     };
     if (width <= 0 || height <= 0)
         fail(fmt::format("the image size {}x{} is not positive", width, height));
     const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height) * 3;
-    if (rgb.size() != n)
-        fail(fmt::format("{} values for a {}x{} RGB image (expected {})", rgb.size(), width, height,
-                         n));
-    const std::vector<uint8_t> bytes = srgbBytes(rgb);
+    if (bytes.size() != n)
+        fail(fmt::format("{} values for a {}x{} RGB image (expected {})", bytes.size(), width,
+                         height, n));
 
     const fs::path target(path);
     const fs::path tmp = temporaryBeside(target);

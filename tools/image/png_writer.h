@@ -20,4 +20,7 @@ std::vector<uint8_t> srgbBytes(std::span<const float> rgb);
 // std::runtime_error with a message "cannot write 'PATH': why".
 void writePng(const std::string& path, int width, int height, std::span<const float> rgb);
 
+// The same, from the 8-bit sRGB values srgbBytes() gives (width * height * 3 bytes).
+void writePngBytes(const std::string& path, int width, int height, std::span<const uint8_t> bytes);
+
 }  // namespace pcsg::tools
