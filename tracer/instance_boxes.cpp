@@ -14,6 +14,7 @@
 #include <type_traits>
 #include <unordered_map>
 
+#include "key_slots.h"
 #include "primitives.h"
 
 namespace pcsg::tracer {
@@ -313,6 +314,7 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
       levels_(g.scene.settings.maxDepth + 2) {
     if (sequence_ && &sequence_->g_ != &g)
         throw std::logic_error("InstanceBoxes: the sequence's boxes belong to another graph");
+    narrowKeySlots(g, deps_);  // keys hash only the parameters that tell instances apart
     for (size_t m = 0; m < lasting_.size() && sequence_; ++m)
         lasting_[m] = deps_[m].analysed && !deps_[m].usesTime;
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);
