@@ -289,7 +289,22 @@ struct WorkerOf {
 
 class InstanceBoxes::Worker : public WorkerOf<BoxSink> {
   public:
-    explicit Worker(const InstanceBoxes& boxes) : WorkerOf<BoxSink>(boxes, boxes.sem_) {}
+    explicit Worker(const InstanceBoxes& boxes)
+        : WorkerOf<BoxSink>(boxes, boxes.sem_), recent_(kRecent) {}
+
+    // The thread's last boxes, direct-mapped by key: an instance's box is a function of
+    // its key, so a hit is the number the table (or an unrolling) would give, found
+    // without the table's shared lock; the box comes padded, as box() returns it.
+    struct Recent {
+        Key key;  // key.a == 0: empty (no key has a == 0)
+        Stored stored;
+        Box padded;
+    };
+    Recent& recent(const Key& k) { return recent_[k.b & (kRecent - 1)]; }
+
+  private:
+    static constexpr size_t kRecent = 512;
+    std::vector<Recent> recent_;
 };
 
 // The prefill's: counts what it unrolls (InstanceBoxes::prefill).
@@ -442,10 +457,16 @@ void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const
 
 Box InstanceBoxes::box(Worker& w, const Key& k, NodeId select, uint32_t depth, const double* frame,
                        uint64_t path) const {
+    Worker::Recent& r = w.recent(k);
+    if (r.key == k) {
+        record(select, depth, r.stored);
+        return r.padded;
+    }
     Stored s;
     if (!find(select, k, s)) s = unroll(w, select, depth, frame, path);
     record(select, depth, s);
-    return paddedBox(s.box);
+    r = {k, s, paddedBox(s.box)};
+    return r.padded;
 }
 
 InstanceBoxes::Stored InstanceBoxes::unroll(Worker& w, NodeId select, uint32_t depth,
