@@ -9,13 +9,27 @@ namespace pcsg {
 
 namespace {
 
+// Slots a key need not hold: fixed ones, and those the C-node has assigned already.
+struct Unread {
+    const FixedSlots* fixed;
+    NodeId node;
+    const std::vector<Slot>* assigned;
+    bool operator()(Slot s) const {
+        return (fixed && fixed->fixed(node, s)) ||
+               std::find(assigned->begin(), assigned->end(), s) != assigned->end();
+    }
+};
+
 // What one expression reads, added to `reads` (without repeats).
-void addReads(const Graph& g, ExprId id, std::vector<uint32_t>& reads, bool& usesPath) {
+void addReads(const Graph& g, ExprId id, std::vector<uint32_t>& reads, bool& usesPath,
+              const Unread& unread) {
     const Expr& e = g.exprs[id];
     for (uint32_t pc = e.begin; pc < e.end; ++pc) {
         const Instr& in = g.code[pc];
         uint32_t r;
-        if (in.op == Op::Load)
+        if (in.op == Op::Load && unread(in.a))
+            continue;
+        else if (in.op == Op::Load)
             r = in.a;
         else if (in.op == Op::Clock)
             r = StepMemoPlan::kClock;
@@ -64,27 +78,33 @@ void fromDoubles(const double* in, Affine& m) {
 
 }  // namespace
 
-StepMemoPlan::StepMemoPlan(const Graph& g) : nodes_(g.nodes.size()) {
+StepMemoPlan::StepMemoPlan(const Graph& g, const FixedSlots* fixed) : nodes_(g.nodes.size()) {
     std::vector<uint32_t> reads;
+    std::vector<Slot> assigned;
     for (NodeId n = 0; n < g.nodes.size(); ++n) {
         const Node& node = g.nodes[n];
         NodePlan& p = nodes_[n];
         reads.clear();
+        assigned.clear();
+        const Unread unread{fixed, n, &assigned};
         if (node.kind == NodeKind::Calc) {
             const Calc& c = g.calcs[node.payload];
             if (c.count > kMaxWrites) continue;
-            for (uint32_t i = 0; i < c.count; ++i)
-                addReads(g, g.assignments[c.first + i].value, reads, p.usesPath);
+            for (uint32_t i = 0; i < c.count; ++i) {
+                const Assignment& a = g.assignments[c.first + i];
+                addReads(g, a.value, reads, p.usesPath, unread);
+                if (!c.simultaneous) assigned.push_back(a.slot);  // later reads see it
+            }
         } else if (node.kind == NodeKind::Select) {
             const Module& m = g.modules[node.payload];
-            if (!m.notationB) addReads(g, m.select, reads, p.usesPath);
+            if (!m.notationB) addReads(g, m.select, reads, p.usesPath, unread);
             for (ExprId c : m.conditions)
-                if (c != kNone) addReads(g, c, reads, p.usesPath);
+                if (c != kNone) addReads(g, c, reads, p.usesPath, unread);
         } else if (node.kind == NodeKind::Transform) {
             const Transform& t = g.transforms[node.payload];
             if (t.constant) continue;
             for (uint32_t i = 0; i < t.argCount; ++i)
-                addReads(g, g.args[t.firstArg + i], reads, p.usesPath);
+                addReads(g, g.args[t.firstArg + i], reads, p.usesPath, unread);
         } else {
             continue;
         }

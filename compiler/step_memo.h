@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "eval.h"
+#include "fixed_slots.h"
 #include "graph.h"
 
 namespace pcsg {
@@ -32,7 +33,10 @@ class StepMemoPlan {
     static constexpr uint32_t kClock = UINT32_MAX;      // a read of `clock`
     static constexpr uint32_t kFrame = UINT32_MAX - 1;  // a read of `frame`
 
-    explicit StepMemoPlan(const Graph& g);
+    // With `fixed`, a node's key leaves out the slots fixed on entry to it (fixed_slots.h):
+    // for walks from the axiom only. A C-node's key holds the slots it reads before it
+    // assigns them.
+    explicit StepMemoPlan(const Graph& g, const FixedSlots* fixed = nullptr);
 
     struct NodePlan {
         uint32_t firstRead = 0,

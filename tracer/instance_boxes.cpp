@@ -14,6 +14,7 @@
 #include <type_traits>
 #include <unordered_map>
 
+#include "key_slots.h"
 #include "primitives.h"
 
 namespace pcsg::tracer {
@@ -288,7 +289,22 @@ struct WorkerOf {
 
 class InstanceBoxes::Worker : public WorkerOf<BoxSink> {
   public:
-    explicit Worker(const InstanceBoxes& boxes) : WorkerOf<BoxSink>(boxes, boxes.sem_) {}
+    explicit Worker(const InstanceBoxes& boxes)
+        : WorkerOf<BoxSink>(boxes, boxes.sem_), recent_(kRecent) {}
+
+    // The thread's last boxes, direct-mapped by key: an instance's box is a function of
+    // its key, so a hit is the number the table (or an unrolling) would give, found
+    // without the table's shared lock; the box comes padded, as box() returns it.
+    struct Recent {
+        Key key;  // key.a == 0: empty (no key has a == 0)
+        Stored stored;
+        Box padded;
+    };
+    Recent& recent(const Key& k) { return recent_[k.b & (kRecent - 1)]; }
+
+  private:
+    static constexpr size_t kRecent = 512;
+    std::vector<Recent> recent_;
 };
 
 // The prefill's: counts what it unrolls (InstanceBoxes::prefill).
@@ -313,6 +329,7 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
       levels_(g.scene.settings.maxDepth + 2) {
     if (sequence_ && &sequence_->g_ != &g)
         throw std::logic_error("InstanceBoxes: the sequence's boxes belong to another graph");
+    narrowKeySlots(g, deps_);  // keys hash only the parameters that tell instances apart
     for (size_t m = 0; m < lasting_.size() && sequence_; ++m)
         lasting_[m] = deps_[m].analysed && !deps_[m].usesTime;
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);
@@ -440,10 +457,16 @@ void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const
 
 Box InstanceBoxes::box(Worker& w, const Key& k, NodeId select, uint32_t depth, const double* frame,
                        uint64_t path) const {
+    Worker::Recent& r = w.recent(k);
+    if (r.key == k) {
+        record(select, depth, r.stored);
+        return r.padded;
+    }
     Stored s;
     if (!find(select, k, s)) s = unroll(w, select, depth, frame, path);
     record(select, depth, s);
-    return paddedBox(s.box);
+    r = {k, s, paddedBox(s.box)};
+    return r.padded;
 }
 
 InstanceBoxes::Stored InstanceBoxes::unroll(Worker& w, NodeId select, uint32_t depth,

@@ -7,8 +7,9 @@
 // so the static box of every sub-triangle spans the whole terrain's height, and a ray
 // that grazes the terrain enters thousands of them. The box of one instance, though, is
 // a function of the instance alone: of its S-node, the values of the parameters its
-// sub-graph reads, and, when the sub-graph calls rand() or choose(), its instance path
-// (walk.h's ModuleDependencies). So the tracer asks this cache for an instance's box.
+// sub-graph reads (less those key_slots.h shows cannot differ between its instances)
+// and, when the sub-graph calls rand() or choose(), its instance path (walk.h's
+// ModuleDependencies). So the tracer asks this cache for an instance's box.
 // A miss unrolls the instance through the shared walk (compiler/walk.h: the same code
 // the expander uses), uniting the boxes of its primitives; the S-node instances met on
 // the way are looked up and stored too, so filling the boxes of a whole object costs one

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -196,6 +197,61 @@ TEST(InstanceBoxes, TheBoxDoesNotDependOnWhatTheCacheHeld) {
         EXPECT_EQ(cold.stats().entries, 0u);
         EXPECT_GT(warm.stats().entries, 0u);
         EXPECT_TRUE(first.isBounded());
+    }
+}
+
+// Every S-node instance of a small system (node, depth, frame, path), by a recursive walk.
+struct SelectInstance {
+    NodeId node;
+    uint32_t depth;
+    std::vector<double> frame;
+    uint64_t path;
+};
+
+void collectInstances(const Graph& g, NodeId n, uint32_t depth, const std::vector<double>& frame,
+                      uint64_t path, std::vector<SelectInstance>& out) {
+    const Node& node = g.nodes[n];
+    if (node.kind == NodeKind::Select) {
+        out.push_back({n, depth + 1, frame, path});
+        const uint32_t r = selectRule(g, n, EvalState{frame.data(), path});
+        collectInstances(g, g.child(n, r), depth + 1, frame, pathRule(path, r), out);
+    } else if (node.kind == NodeKind::Calc) {
+        std::vector<double> next(g.slotCount());
+        applyCalc(g, n, EvalState{frame.data(), path}, next.data());
+        collectInstances(g, g.child(n), depth, next, path, out);
+    } else if (node.kind == NodeKind::Operator) {
+        for (uint32_t i = 0; i < node.childCount; ++i)
+            collectInstances(g, g.child(n, i), depth, frame, pathChild(path, i), out);
+    } else if (node.kind != NodeKind::Primitive) {
+        collectInstances(g, g.child(n), depth, frame, path, out);
+    }
+}
+
+// A worker recalls the boxes it computed last (by key, in a small direct-mapped table):
+// asked again in any order, it gives what a fresh worker of a fresh cache computes.
+TEST(InstanceBoxes, AWorkersRecalledBoxesAreTheComputedOnes) {
+    for (const char* text : {kTree, kTerrain}) {
+        auto c = compile(text);
+        ASSERT_TRUE(c->graph);
+        const Graph& g = *c->graph;
+        const Bounds bounds = computeBounds(g);
+        std::vector<double> frame(g.slotCount());
+        initFrame(g, frame.data());
+        std::vector<SelectInstance> all;
+        collectInstances(g, g.axiom, 0, frame, kRootPath, all);
+        ASSERT_GT(all.size(), 200u);  // enough that keys share the worker's slots
+        const InstanceBoxes boxes(g, bounds, always());
+        auto w = boxes.makeWorker();
+        std::mt19937 rng(11);
+        for (int round = 0; round < 3; ++round) {
+            std::shuffle(all.begin(), all.end(), rng);
+            for (const SelectInstance& i : all) {
+                const InstanceBoxes fresh(g, bounds, storingNothing());
+                auto fw = fresh.makeWorker();
+                const Box expected = fresh.box(*fw, i.node, i.depth, i.frame.data(), i.path);
+                ASSERT_EQ(boxes.box(*w, i.node, i.depth, i.frame.data(), i.path), expected);
+            }
+        }
     }
 }
 

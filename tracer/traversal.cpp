@@ -63,9 +63,18 @@ void TraceScene::markPaintFrames() {
     if (any) paintFrames = std::move(marks);
 }
 
+namespace {
+// The tracer's walks all start at the axiom: their memo keys leave out the fixed slots
+// (the terrain's C-nodes then read few enough values to be memoised at all).
+StepMemoPlan axiomMemoPlan(const Graph& g) {
+    const FixedSlots fixed(g);
+    return StepMemoPlan(g, &fixed);
+}
+}  // namespace
+
 TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
                        const InstanceBoxOptions& instanceBoxOptions)
-    : g_(g), sem_(g), memoPlan_(g), bounds_(std::move(bounds)) {
+    : g_(g), sem_(g), memoPlan_(axiomMemoPlan(g)), bounds_(std::move(bounds)) {
     const size_t n = g.nodes.size();
     if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
     markPaintFrames();
