@@ -169,6 +169,7 @@ const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t dept
     const UnrolledInstance* x = expansion_->get(*key, n, depth, c.frame, c.path);
     // Used only where its deepest S-node stays within max_depth (else the walk reports it).
     if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
+    if (x && anyHit_) occluder_.entering(n, depth, *key);
     return x;
 }
 
@@ -182,6 +183,7 @@ const UnrolledInstance* Tracer::builtAt(NodeId n, const Ctx& c, uint32_t depth,
     key = scene_.instanceBoxes_->keyOf(n, c.frame, c.path);
     const UnrolledInstance* x = expansion_->built(*key, n, depth);
     if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
+    if (x && anyHit_) occluder_.entering(n, depth, *key);
     return x;
 }
 
@@ -226,6 +228,9 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
+    if (anyHit_ && expansion_ &&
+        occluder_.occludes(*expansion_, g_.scene.settings.maxDepth, r, tmin, tmax))
+        return true;
     if (scene_.useBounds) {
         double t0 = tmin, t1 = tmax;
         if (!clipToBox(scene_.bounds_.node[g_.axiom], origin, dir, t0, t1)) return false;
@@ -302,9 +307,9 @@ template <class Below, class Unrolled, class TransformBack>
     Result found;
     if (st.inverse) {
         const LocalRay rr{st.inverse->point(r.o), st.inverse->vector(r.d)};
-        if (scene_.paintMaps && !anyHit_) inverses_.push_back(st.inverse);
+        if (scene_.paintMaps || anyHit_) inverses_.push_back(st.inverse);
         found = transformBack(*st.inverse, [&] { return below(st.child, rr, st.state); });
-        if (scene_.paintMaps && !anyHit_) inverses_.pop_back();
+        if (scene_.paintMaps || anyHit_) inverses_.pop_back();
     } else {
         found = below(st.child, r, st.state);
     }
@@ -345,8 +350,11 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                     return first(below, rr, cc, tmin, tmax, hit);
                 },
                 [&](const UnrolledInstance& x, const Ctx& cc) {
-                    return x.first(r, tmin, tmax, hit, {cc.path, cc.material, cc.paint}, anyHit_,
-                                   expansion_->scratch());
+                    if (anyHit_ && occluder_.missed(cc.path)) return false;
+                    const bool found = x.first(r, tmin, tmax, hit, {cc.path, cc.material, cc.paint},
+                                               anyHit_, expansion_->scratch());
+                    if (found && anyHit_) occluder_.keep(inverses_, cc.path, cc.material);
+                    return found;
                 },
                 [&](const Affine& inv, auto&& walkBelow) {
                     if (!walkBelow()) return false;

@@ -52,6 +52,7 @@
 #include "eval.h"
 #include "graph.h"
 #include "instance_boxes.h"
+#include "last_occluder.h"
 #include "operators.h"
 #include "primitives.h"
 #include "semantics.h"
@@ -171,6 +172,8 @@ class Tracer {
     uint64_t expansions() const { return expansion_ ? expansion_->expansions() : 0; }
     size_t expansionCacheBytes() const { return expansion_ ? expansion_->cache().bytes() : 0; }
     size_t expansionCacheEntries() const { return expansion_ ? expansion_->cache().entries() : 0; }
+    // Shadow rays answered by the copy of an instance that stopped an earlier one.
+    uint64_t shadowShortcuts() const { return occluder_.stopped(); }
     // The lowest stack address a walk reached (for the stack-size test).
     uintptr_t stackLowWater() const { return lowWater_; }
 
@@ -245,8 +248,10 @@ class Tracer {
     // With TraceScene::paintMaps: the inverse matrices of the T-nodes above the node being
     // visited, outermost first, and the map from the world into each paint node's frame
     // (beside paintRays_; identity where the material has no normal pattern).
+    // (also in shadow rays' walks, for occluder_)
     std::vector<const Affine*> inverses_;
     std::vector<Affine> paintMaps_;
+    LastOccluder occluder_;  // shadow rays: the copy of an instance that stopped the last one
     bool anyHit_ = false;
     uint64_t visits_ = 0;
     uintptr_t stackLimit_ = UINTPTR_MAX;  // not yet known (0: unknown to the system)

@@ -9,6 +9,7 @@
 
 #include "bounds.h"
 #include "eval.h"
+#include "outward_float.h"
 #include "traversal.h"
 
 namespace pcsg::tracer {
@@ -253,11 +254,22 @@ class Unroller {
         collect(n, Affine::identity(), kNone, 0, items);
         for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
         if (items.size() <= kFewItems) return;                // the union's own operands will do
-        out_.nodes_[n].bvh = split(items, 0, items.size());
+        binary_.clear();
+        const uint32_t root = split(items, 0, items.size());
+        out_.nodes_[n].bvh = collapse(root);
+        out_.bvhLeaves_ += static_cast<uint32_t>(items.size());
     }
 
-    // The hierarchy over items[begin, end) (two or more): halves at the median of the
-    // items' centres along the axis where the centres spread widest. Returns its root.
+    // A node of the binary hierarchy that collapse() turns into four-wide nodes: child c
+    // is another binary node or (kLeaf) an operand, as in BvhNode.
+    struct Binary {
+        Box box[2];
+        uint32_t child[2], link[2];
+    };
+
+    // The binary hierarchy over items[begin, end) (two or more), in binary_: halves at the
+    // median of the items' centres along the axis where the centres spread widest. Returns
+    // its root.
     uint32_t split(std::vector<Item>& items, size_t begin, size_t end) {
         Box centres;
         for (size_t k = begin; k < end; ++k) centres.extend(items[k].box.center());
@@ -277,8 +289,8 @@ class Unroller {
         if (axis >= 0)
             std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
                              [&](const Item& a, const Item& b) { return centre(a) < centre(b); });
-        const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
-        out_.bvh_.emplace_back();
+        const uint32_t index = static_cast<uint32_t>(binary_.size());
+        binary_.emplace_back();
         const size_t bounds[3] = {begin, mid, end};
         for (int c = 0; c < 2; ++c) {
             Box box;
@@ -290,15 +302,66 @@ class Unroller {
             } else {
                 child = split(items, bounds[c], bounds[c + 1]);
             }
-            BvhNode& b = out_.bvh_[index];
-            for (int a = 0; a < 3; ++a) {
-                b.lo[a][c] = box.lo[a];
-                b.hi[a][c] = box.hi[a];
-            }
+            Binary& b = binary_[index];
+            b.box[c] = box;
             b.child[c] = child;
             b.link[c] = link;
         }
         return index;
+    }
+
+    // The four-wide node of binary node `root`: its two children, and in their place the
+    // children of the inner one with the largest box while there is room. Returns its
+    // index in out_.bvh_.
+    uint32_t collapse(uint32_t root) {
+        struct Slot {
+            uint32_t child, link;
+            Box box;
+        };
+        Slot slots[4];
+        int n = 0;
+        for (int c = 0; c < 2; ++c)
+            slots[n++] = {binary_[root].child[c], binary_[root].link[c], binary_[root].box[c]};
+        while (n < 4) {
+            int open = -1;
+            double largest = 0;
+            for (int k = 0; k < n; ++k) {
+                if (slots[k].child & UnrolledInstance::kLeaf) continue;
+                const double area = halfArea(slots[k].box);
+                if (open < 0 || area > largest) open = k, largest = area;
+            }
+            if (open < 0) break;
+            const Binary& b = binary_[slots[open].child];
+            slots[n++] = {b.child[1], b.link[1], b.box[1]};
+            slots[open] = {b.child[0], b.link[0], b.box[0]};
+        }
+        const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
+        out_.bvh_.emplace_back();
+        for (int k = 0; k < 4; ++k) {
+            uint32_t child = kNone, link = kNone;
+            Box box{{0, 0, 0}, {0, 0, 0}};  // an empty slot: never entered
+            if (k < n) {
+                box = slots[k].box;
+                link = slots[k].link;
+                child = (slots[k].child & UnrolledInstance::kLeaf) ? slots[k].child
+                                                                   : collapse(slots[k].child);
+            }
+            BvhNode& b = out_.bvh_[index];
+            for (int a = 0; a < 3; ++a) {
+                b.lo[a][k] = floatBelow(box.lo[a]);
+                b.hi[a][k] = floatAbove(box.hi[a]);
+            }
+            b.child[k] = child;
+            b.link[k] = link;
+        }
+        return index;
+    }
+
+    // The half surface of a box (NaN or infinite when it is unbounded: opened last or
+    // first, which only orders the hierarchy).
+    static double halfArea(const Box& b) {
+        const Vec3 e = b.hi - b.lo;
+        return e.x * e.y + e.y * e.z + e.z * e.x;
     }
 
     void setChoices(Node& x) {
@@ -328,6 +391,7 @@ class Unroller {
     std::vector<uint32_t> choices_;
     std::vector<uint32_t> kids_;                        // operands of the operators being built
     std::unordered_map<uint64_t, uint32_t> linkIndex_;  // linkTo()'s links by (parent, matrix)
+    std::vector<Binary> binary_;                        // the hierarchy being built
 };
 
 // ---------------------------------------------------------------------------------------
@@ -478,29 +542,41 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
 
 namespace {
 
-// Where the ray enters each of a BVH node's two child boxes within [tmin, tmax]
-// (t0[c]), and which it meets at all (bit c of the result). Boxes are only culling
-// here: hits do not depend on them, so the two are tested side by side in SSE2
-// registers, with the same rule as clipToBox for a NaN (it culls nothing).
+// Where the ray enters each of a BVH node's child boxes within [tmin, tmax] (t0[c]), and
+// which it meets at all (bit c of the result; never an empty slot). Boxes are only
+// culling here: hits do not depend on them, so they are tested two at a time in SSE2
+// registers, in doubles, with the same rule as clipToBox for a NaN (it culls nothing).
 int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, double tmin, double tmax,
-                  double t0[2]) {
+                  double t0[4]) {
+    int used = 0;
+    for (int c = 0; c < 4; ++c) used |= (b.child[c] != kNone) << c;
     const Vec3& inv = r.inverse();
 #if defined(__SSE2__)
     if (!r.hasZeroAxis()) {
-        __m128d lo = _mm_set1_pd(tmin), hi = _mm_set1_pd(tmax);
+        __m128d lo[2] = {_mm_set1_pd(tmin), _mm_set1_pd(tmin)};
+        __m128d hi[2] = {_mm_set1_pd(tmax), _mm_set1_pd(tmax)};
         for (int a = 0; a < 3; ++a) {
             const __m128d o = _mm_set1_pd(r.o[a]), iv = _mm_set1_pd(inv[a]);
-            const __m128d x = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(b.lo[a]), o), iv);
-            const __m128d y = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(b.hi[a]), o), iv);
-            lo = _mm_max_pd(_mm_min_pd(y, x), lo);
-            hi = _mm_min_pd(_mm_max_pd(x, y), hi);
+            const __m128 bl = _mm_load_ps(b.lo[a]), bh = _mm_load_ps(b.hi[a]);
+            const __m128d l[2] = {_mm_cvtps_pd(bl), _mm_cvtps_pd(_mm_movehl_ps(bl, bl))};
+            const __m128d h[2] = {_mm_cvtps_pd(bh), _mm_cvtps_pd(_mm_movehl_ps(bh, bh))};
+            for (int p = 0; p < 2; ++p) {
+                const __m128d x = _mm_mul_pd(_mm_sub_pd(l[p], o), iv);
+                const __m128d y = _mm_mul_pd(_mm_sub_pd(h[p], o), iv);
+                lo[p] = _mm_max_pd(_mm_min_pd(y, x), lo[p]);
+                hi[p] = _mm_min_pd(_mm_max_pd(x, y), hi[p]);
+            }
         }
-        _mm_storeu_pd(t0, lo);
-        return _mm_movemask_pd(_mm_cmple_pd(lo, hi));
+        _mm_storeu_pd(t0, lo[0]);
+        _mm_storeu_pd(t0 + 2, lo[1]);
+        const int mask = _mm_movemask_pd(_mm_cmple_pd(lo[0], hi[0])) |
+                         (_mm_movemask_pd(_mm_cmple_pd(lo[1], hi[1])) << 2);
+        return mask & used;
     }
 #endif
     int mask = 0;
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < 4; ++c) {
+        if (!(used & (1 << c))) continue;
         const Box box{{b.lo[0][c], b.lo[1][c], b.lo[2][c]}, {b.hi[0][c], b.hi[1][c], b.hi[2][c]}};
         double t1 = tmax;
         t0[c] = tmin;
@@ -513,15 +589,16 @@ int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, double 
 
 // The first hit in a union's BVH: the nodes front to back by the ray's entry into them
 // (a stack of the ones still to visit, nearer ones on top), each skipped once its entry
-// lies beyond the nearest hit so far.
+// lies beyond the nearest hit so far. (The order only saves work: a hit is the nearest
+// (t, key) of all operands whose boxes the ray meets before it, whatever the order.)
 bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax,
                                 Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
     struct Pending {
         uint32_t child, link;
         double t0;
     };
-    // Deeper than any hierarchy of median splits (two entries per level at most).
-    constexpr int kStack = 2 * 32 + 2;
+    // Deeper than any hierarchy of median splits (four entries per level at most).
+    constexpr int kStack = 4 * 32 + 4;
     Pending stack[kStack];
     int top = 0;
     stack[top++] = {root, kNone, tmin};
@@ -542,15 +619,15 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
             continue;
         }
         const BvhNode& b = bvh_[p.child];
-        double t0[2];
-        const int mask = enterChildren(b, r, tmin, tmax, t0);
-        if (mask == 3) {
-            const int nearer = t0[1] < t0[0] ? 1 : 0;
-            stack[top++] = {b.child[1 - nearer], b.link[1 - nearer], t0[1 - nearer]};
-            stack[top++] = {b.child[nearer], b.link[nearer], t0[nearer]};
-        } else if (mask != 0) {
-            const int c = mask - 1;
-            stack[top++] = {b.child[c], b.link[c], t0[c]};
+        double t0[4];
+        int mask = enterChildren(b, r, tmin, tmax, t0);
+        // The children met, farthest pushed first (by insertion: at most four).
+        const int base = top;
+        for (; mask != 0; mask &= mask - 1) {
+            const int c = __builtin_ctz(static_cast<unsigned>(mask));
+            int k = top++;
+            for (; k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
+            stack[k] = {b.child[c], b.link[c], t0[c]};
         }
     }
     return found;

@@ -66,14 +66,16 @@ class UnrolledInstance {
     // it (each operand with the matrices on its way, so the arithmetic stays the same) in a
     // bounding-volume hierarchy, because the derivation nests them as the rules do (a
     // flower's 21 petals as a chain 21 unions deep). Spans still follow the derivation.
-    // A node holds the boxes of its two children side by side, so that one SSE2 operation
-    // tests an axis of both; child c is another node (bvh_[child[c]]) or, with kLeaf set,
-    // an operand (nodes_[child[c] & ~kLeaf]) entered through the chain of matrices link[c]
-    // (links_; kNone: none) and then its own.
+    // A node holds the boxes of up to four children side by side, in floats rounded
+    // outwards (boxes only cull: a larger box never changes a hit), so that a node is two
+    // cache lines and SSE2 tests an axis of two children at a time; child c is another
+    // node (bvh_[child[c]]), or, with kLeaf set, an operand (nodes_[child[c] & ~kLeaf])
+    // entered through the chain of matrices link[c] (links_; kNone: none) and then its
+    // own, or kNone: an empty slot (after the used ones).
     static constexpr uint32_t kLeaf = 1u << 31;
-    struct BvhNode {
-        double lo[3][2], hi[3][2];
-        uint32_t child[2], link[2];
+    struct alignas(64) BvhNode {
+        float lo[3][4], hi[3][4];
+        uint32_t child[4], link[4];
     };
 
     // Where an instance is used: the S-node's instance path, the material above it and the
@@ -127,7 +129,7 @@ class UnrolledInstance {
     uint32_t levels() const { return levels_; }
     size_t bytes() const;
     // The nodes of the first-hit hierarchies, leaves included.
-    size_t bvhNodes() const { return bvh_.empty() ? 0 : 2 * bvh_.size() + 1; }
+    size_t bvhNodes() const { return bvh_.size() + bvhLeaves_; }
 
   private:
     friend class Unroller;
@@ -155,6 +157,7 @@ class UnrolledInstance {
     std::vector<Link> links_;
     uint32_t root_ = kNone;
     uint32_t levels_ = 0;
+    uint32_t bvhLeaves_ = 0;
 };
 
 }  // namespace pcsg::tracer

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "bounds.h"
+#include "outward_float.h"
 #include "test_support.h"
 #include "traversal.h"
 
@@ -167,6 +168,45 @@ TEST(ExpandedInstances, AChainOfUnionsGetsAHierarchyAndTheSameHits) {
     // 22 primitives under one hierarchy: at least 22 / 4 leaves.
     EXPECT_GE(x->bvhNodes(), 6u);
     EXPECT_EQ(cache.expansions(), 1u);
+}
+
+// Three operands per level (27 and 81 leaves): four-wide nodes with empty slots, whose
+// float boxes are rounded outwards, around spheres placed by parameters 1000 units from
+// the instance's origin (a float's step there is 6e-5) and 1e-3 in radius.
+const char* kThrees = R"(
+{n = 4; x = 0; y = 0; s = 1} move(0, 0, -1000) T
+T if(n > 0, 2, 1)
+1: T -> move(x, y, 1000) (uscale(0.08) sphere ∪ move(0.1, 0, 0) uscale(1e-3) sphere)
+2: T -> {n = n-1; s = s*0.5} ({x = x+s} T ∪ {x = x-s; y = y+s*0.4} T ∪ {y = y-s*0.8} T)
+)";
+
+TEST(ExpandedInstances, FourWideHierarchiesWithEmptySlotsHitTheSameSurfaces) {
+    EXPECT_GT(compareWithGraphWalk(kThrees, 0.6, 20), 0u);
+}
+
+TEST(ExpandedInstances, BoxesRoundOutwardsToFloats) {
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> mantissa(1, 2);
+    std::uniform_int_distribution<int> exponent(-160, 160);
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> xs = {0.0,          -0.0,   1.0,     0.1,   -0.1,   1e-45, 1e-50, -1e-50,
+                              3.4028234e38, 3.5e38, -3.5e38, 1e300, -1e300, inf,   -inf};
+    for (int i = 0; i < 2000; ++i)
+        xs.push_back((i % 2 ? -1 : 1) * std::ldexp(mantissa(rng), exponent(rng)));
+    for (double x : xs) {
+        const float lo = floatBelow(x), hi = floatAbove(x);
+        EXPECT_LE(static_cast<double>(lo), x) << x;
+        EXPECT_GE(static_cast<double>(hi), x) << x;
+        // the nearest such floats: one step further is on the other side of x
+        if (std::isfinite(x) && std::isfinite(lo)) {
+            EXPECT_GT(static_cast<double>(std::nextafter(lo, INFINITY)), x) << x;
+        }
+        if (std::isfinite(x) && std::isfinite(hi)) {
+            EXPECT_LT(static_cast<double>(std::nextafter(hi, -INFINITY)), x) << x;
+        }
+    }
+    EXPECT_TRUE(std::isnan(floatBelow(std::nan(""))));
+    EXPECT_TRUE(std::isnan(floatAbove(std::nan(""))));
 }
 
 TEST(ExpandedInstances, TheCacheStaysWithinItsBudget) {
