@@ -21,7 +21,7 @@ TEST(AaEncodeMemo, GivesAaEncodesBitsWhateverItRemembered) {
     // Repeats, as a sky's pixels are, and after others have overwritten their slots.
     for (int i = 0; i < 2000; ++i) values.push_back(values[static_cast<size_t>(i) * 7]);
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    for (float v : {0.0f, -0.0f, -0.25f, 1.0f, 1e-30f, 3.5e38f, nan, -nan,
+    for (float v : {0.0f, -0.0f, -0.25f, 1.0f, 1e-30f, 3.4e38f, nan, -nan,
                     std::bit_cast<float>(0xffffffffu), std::bit_cast<float>(0x7f800000u)})
         values.push_back(v);
     AaEncodeMemo memo;
