@@ -285,7 +285,7 @@ void UnrollCache::refuse(size_t y) {
 }
 
 // Counts an expansion of `bytes` at level y; stops expansion there when its large
-// instances have been built for more bytes than the budget.
+// instances have been built for more bytes than half the budget.
 void UnrollCache::count(size_t y, NodeId select, uint32_t depth, size_t bytes) {
     Yield& yield = yield_[y];
     yield.built.fetch_add(1, std::memory_order_relaxed);
@@ -295,7 +295,7 @@ void UnrollCache::count(size_t y, NodeId select, uint32_t depth, size_t bytes) {
         builtWeight_.fetch_add(w, std::memory_order_relaxed);
     }
     if (bytes <= maxBytes_ / kLarge) return;
-    if (yield.largeBytes.fetch_add(bytes, std::memory_order_relaxed) + bytes > maxBytes_)
+    if (yield.largeBytes.fetch_add(bytes, std::memory_order_relaxed) + bytes > maxBytes_ / 2)
         yield.off.store(true, std::memory_order_relaxed);
 }
 

@@ -27,7 +27,8 @@
 //  - Thrashing: an evicted instance leaves a note behind; expanding it again counts as a
 //    rebuild, and where a third of the expansions are rebuilds, expansion stops. Where
 //    instances larger than 1/64 of the budget have been built for more bytes, in all,
-//    than the budget (a terrain's patches, each used by the rays of a few tiles), it stops
+//    than half the budget (a terrain's patches, each used by the rays of a few tiles, or
+//    a level the budget cannot hold twice over), it stops
 //    too: large instances pay only where they are few and used again and again (a
 //    deterministic tree or fractal, whose every level is one instance).
 #pragma once
