@@ -388,6 +388,12 @@ bool InstanceBoxes::unrollAt(NodeId select, uint32_t depth) const {
     return expand_[i].load(std::memory_order_relaxed) != 0;
 }
 
+uint64_t InstanceBoxes::unrollWeight(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return 0;
+    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    return maxWeight_[i].load(std::memory_order_relaxed);
+}
+
 // Two lanes of xxHash64's round (acc = rotl(acc + v * P2, 31) * P1), each with its own
 // constants, finished with SplitMix64's finaliser: one multiplication per value on each
 // lane's dependency chain, where a full finaliser per value took three.

@@ -67,9 +67,10 @@ struct InstanceBoxOptions {
     // some axis.
     double gain = 0.8;
     // Depths whose instances all took between these many visits to unroll are worth
-    // expanding (unrolled_instances.h).
+    // expanding (unrolled_instances.h). The upper limit only bounds the candidates: the
+    // expansion cache (unroll_cache.h) keeps to the instances that fit its byte budget.
     uint64_t minExpandWeight = 12;
-    uint64_t maxUnrollWeight = 8192;
+    uint64_t maxUnrollWeight = 1u << 20;
     // The frames of a sequence share the boxes that do not change with the time (see
     // SequenceInstanceBoxes); null: every box in this cache's own table.
     std::shared_ptr<SequenceInstanceBoxes> sequence;
@@ -95,6 +96,9 @@ class InstanceBoxes {
     // with useAt, from the sizes of the first instances met there.
     bool unrollAt(NodeId select, uint32_t depth) const;
     uint64_t maxUnrollWeight() const { return opt_.maxUnrollWeight; }
+    // The visits the heaviest instance of this S-node at this depth took to unroll, of
+    // those met so far (0: none), for the expansion cache's estimate of their bytes.
+    uint64_t unrollWeight(NodeId select, uint32_t depth) const;
 
     // An instance: its S-node, the values of the parameters its sub-graph reads and, when
     // it calls rand() or choose(), its instance path, hashed to 128 bits.

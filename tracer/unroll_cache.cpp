@@ -23,6 +23,15 @@ constexpr uint32_t kUseBatch = 32;
 // Expansions at a (module, depth) that are used less than kUses times each on average
 // (judged from kTrial expansions on) do not pay.
 constexpr uint64_t kTrial = 64, kUses = 4;
+// One instance takes at most 1/kShare of the budget; instances above 1/kLarge of it are
+// large (see unroll_cache.h). Where a third (1/kRebuilds) of the expansions at a level are
+// rebuilds of evicted instances, the level thrashes.
+constexpr size_t kShare = 8, kLarge = 64;
+constexpr uint64_t kRebuilds = 3;
+// The bytes per node visit of an expansion: the estimate before the first one, and the
+// fewest, which bounds the visits of one (an expansion that reaches the limit is refused).
+constexpr double kFirstBytesPerVisit = 64;
+constexpr size_t kMinBytesPerVisit = 32;
 
 }  // namespace
 
@@ -32,6 +41,7 @@ struct UnrollCache::Entry {
     std::atomic<bool> referenced{false};         // used since the eviction hand passed
     std::unique_ptr<UnrolledInstance> instance;  // Built
     size_t bytes = kNoteBytes;
+    bool evicted = false;  // a note left by an instance that was built and evicted
 };
 
 struct alignas(64) UnrollCache::Shard {
@@ -40,7 +50,8 @@ struct alignas(64) UnrollCache::Shard {
 };
 
 struct UnrollCache::Yield {
-    std::atomic<uint64_t> built{0}, used{0};
+    std::atomic<uint64_t> built{0}, used{0}, rebuilt{0}, refused{0};
+    std::atomic<uint64_t> largeBytes{0};  // of the large instances built
     std::atomic<bool> off{false};
 };
 
@@ -55,6 +66,17 @@ UnrollCache::~UnrollCache() = default;
 
 UnrollCache::Shard& UnrollCache::shardOf(const InstanceBoxes::Key& k) const {
     return shards_[k.a % kShards];
+}
+
+size_t UnrollCache::maxInstanceBytes() const {
+    return maxBytes_ / kShare;
+}
+
+UnrollCache::Level UnrollCache::level(NodeId select, uint32_t depth) const {
+    if (depth >= levels_) return {};
+    const Yield& y = yield_[yieldIndex(select, depth)];
+    return {y.built.load(std::memory_order_relaxed), y.rebuilt.load(std::memory_order_relaxed),
+            y.refused.load(std::memory_order_relaxed), y.off.load(std::memory_order_relaxed)};
 }
 
 size_t UnrollCache::yieldIndex(NodeId select, uint32_t depth) const {
@@ -83,9 +105,16 @@ void UnrollCache::evict() {
                 queue_.push_back(k);
                 continue;
             }
-            if (e.instance) {
+            if (e.instance) {  // leaves a note behind (a later expansion is a rebuild)
                 freed += e.bytes;
                 out.push_back(std::move(e.instance));
+                bytes_.fetch_sub(e.bytes - kNoteBytes, std::memory_order_relaxed);
+                e.bytes = kNoteBytes;
+                e.state = Entry::State::Note;
+                e.evicted = true;
+                e.referenced.store(true, std::memory_order_relaxed);  // (a second round)
+                queue_.push_back(k);
+                continue;
             }
             bytes_.fetch_sub(e.bytes, std::memory_order_relaxed);
             entries_.fetch_sub(1, std::memory_order_relaxed);
@@ -163,11 +192,7 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
             used(y);
             return it->second.instance.get();
         } else if (it->second.state == Entry::State::Note) {
-            const uint64_t b = yield.built.load(std::memory_order_relaxed);
-            if (b >= kTrial && yield.used.load(std::memory_order_relaxed) + uses_[y] < kUses * b) {
-                yield.off.store(true, std::memory_order_relaxed);
-                return nullptr;
-            }
+            if (cache_.stopsAt(y, select, depth, it->second.evicted, uses_[y])) return nullptr;
             it->second.state = Entry::State::Building;  // the second meeting: expand
             e = &it->second;
         }
@@ -190,21 +215,24 @@ const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e, size_t y
                                                     uint64_t path) {
     std::unique_ptr<UnrolledInstance> x;
     try {
-        x = UnrolledInstance::expand(cache_.scene_, select, depth, frame, path,
-                                     4 * cache_.scene_.instanceBoxes()->maxUnrollWeight());
+        const uint64_t maxVisits =
+            std::min<uint64_t>(4 * cache_.scene_.instanceBoxes()->maxUnrollWeight(),
+                               cache_.maxInstanceBytes() / kMinBytesPerVisit);
+        x = UnrolledInstance::expand(cache_.scene_, select, depth, frame, path, maxVisits);
     } catch (...) {
         tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
         e.state = Entry::State::Note;
         throw;
     }
     const UnrolledInstance* result = x.get();
+    const size_t b = x ? x->bytes() + kNoteBytes : SIZE_MAX;
     {
         tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
-        if (!x) {
+        if (b > cache_.maxInstanceBytes()) {  // (x, if any, is freed here: nobody has it)
             e.state = Entry::State::TooLarge;
+            cache_.refuse(y);
             return nullptr;
         }
-        const size_t b = x->bytes() + kNoteBytes;
         cache_.bytes_.fetch_add(b - e.bytes, std::memory_order_relaxed);
         e.bytes = b;
         e.instance = std::move(x);
@@ -213,10 +241,62 @@ const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e, size_t y
     }
     ++expansions_;
     cache_.expansions_.fetch_add(1, std::memory_order_relaxed);
-    cache_.yield_[y].built.fetch_add(1, std::memory_order_relaxed);
+    cache_.count(y, select, depth, b);
     used(y);
     if (cache_.bytes() > cache_.maxBytes_ || cache_.retiredBytes() > 0) cache_.evict();
     return result;
+}
+
+// Whether expansion stops at level y (select, depth), before the expansion of an instance
+// met a second time (`rebuild`: one that was built and evicted before): its expansions are
+// not used enough, or a third of them are rebuilds, or its instances would not fit.
+bool UnrollCache::stopsAt(size_t y, NodeId select, uint32_t depth, bool rebuild,
+                          uint32_t pendingUses) {
+    Yield& yield = yield_[y];
+    const uint64_t b = yield.built.load(std::memory_order_relaxed);
+    uint64_t rebuilt = yield.rebuilt.load(std::memory_order_relaxed);
+    if (rebuild) rebuilt = yield.rebuilt.fetch_add(1, std::memory_order_relaxed) + 1;
+    const bool stop =
+        (b >= kTrial && (yield.used.load(std::memory_order_relaxed) + pendingUses < kUses * b ||
+                         rebuilt * kRebuilds > b)) ||
+        (b == 0 && predictedTooLarge(select, depth));
+    if (stop) yield.off.store(true, std::memory_order_relaxed);
+    return stop;
+}
+
+// Whether the instances at (select, depth) would take more than maxInstanceBytes(), from
+// the weight of the heaviest met there and the bytes per visit of the expansions so far.
+bool UnrollCache::predictedTooLarge(NodeId select, uint32_t depth) const {
+    const uint64_t w = scene_.instanceBoxes()->unrollWeight(select, depth);
+    const uint64_t bytes = builtBytes_.load(std::memory_order_relaxed);
+    const uint64_t visits = builtWeight_.load(std::memory_order_relaxed);
+    const double perVisit =
+        visits > 0 ? static_cast<double>(bytes) / static_cast<double>(visits) : kFirstBytesPerVisit;
+    return static_cast<double>(w) * perVisit > static_cast<double>(maxInstanceBytes());
+}
+
+// Counts an instance too large to keep at level y; stops expansion there when more than a
+// quarter of its instances were.
+void UnrollCache::refuse(size_t y) {
+    Yield& yield = yield_[y];
+    const uint64_t refused = yield.refused.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (refused * 4 > yield.built.load(std::memory_order_relaxed))
+        yield.off.store(true, std::memory_order_relaxed);
+}
+
+// Counts an expansion of `bytes` at level y; stops expansion there when its large
+// instances have been built for more bytes than half the budget.
+void UnrollCache::count(size_t y, NodeId select, uint32_t depth, size_t bytes) {
+    Yield& yield = yield_[y];
+    yield.built.fetch_add(1, std::memory_order_relaxed);
+    const uint64_t w = scene_.instanceBoxes()->unrollWeight(select, depth);
+    if (w > 0) {
+        builtBytes_.fetch_add(bytes, std::memory_order_relaxed);
+        builtWeight_.fetch_add(w, std::memory_order_relaxed);
+    }
+    if (bytes <= maxBytes_ / kLarge) return;
+    if (yield.largeBytes.fetch_add(bytes, std::memory_order_relaxed) + bytes > maxBytes_ / 2)
+        yield.off.store(true, std::memory_order_relaxed);
 }
 
 }  // namespace pcsg::tracer

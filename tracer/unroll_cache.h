@@ -17,6 +17,20 @@
 //    (each thread adds its uses in batches); where the expansions are used less than four
 //    times each, expansion stops. None of this changes a hit: an expanded instance gives
 //    the same surfaces, bit for bit, as the graph walk.
+//  - Size: one instance may take at most an eighth of the budget. A larger one is refused
+//    (its entry stays a note that is never expanded) and so, once they are more than a
+//    few, are the others of its (module, depth), and expansion stops there: the walk
+//    goes below them and meets the smaller instances of the deeper levels, which are
+//    expanded instead. Before expanding, the bytes are estimated from the heaviest
+//    instance InstanceBoxes met at that depth and the bytes per visit of the expansions
+//    so far, so that a level far too large is not even tried.
+//  - Thrashing: an evicted instance leaves a note behind; expanding it again counts as a
+//    rebuild, and where a third of the expansions are rebuilds, expansion stops. Where
+//    instances larger than 1/64 of the budget have been built for more bytes, in all,
+//    than half the budget (a terrain's patches, each used by the rays of a few tiles, or
+//    a level the budget cannot hold twice over), it stops
+//    too: large instances pay only where they are few and used again and again (a
+//    deterministic tree or fractal, whose every level is one instance).
 #pragma once
 
 #include <atomic>
@@ -49,6 +63,17 @@ class UnrollCache {
     size_t entries() const { return entries_.load(std::memory_order_relaxed); }
     size_t retiredBytes() const { return retired_.pendingBytes(); }
     size_t maxBytes() const { return maxBytes_; }
+    // The largest instance kept (an eighth of the budget).
+    size_t maxInstanceBytes() const;
+
+    // What happened at one (module, depth) so far.
+    struct Level {
+        uint64_t built = 0;    // expansions (rebuilds included)
+        uint64_t rebuilt = 0;  // expansions of instances that were built and evicted before
+        uint64_t refused = 0;  // expansions larger than maxInstanceBytes(), thrown away
+        bool off = false;      // expansion stopped there
+    };
+    Level level(NodeId select, uint32_t depth) const;
 
   private:
     struct Entry;
@@ -59,6 +84,10 @@ class UnrollCache {
     Shard& shardOf(const InstanceBoxes::Key& k) const;
     size_t yieldIndex(NodeId select, uint32_t depth) const;
     void evict();
+    bool predictedTooLarge(NodeId select, uint32_t depth) const;
+    bool stopsAt(size_t y, NodeId select, uint32_t depth, bool rebuild, uint32_t pendingUses);
+    void count(size_t y, NodeId select, uint32_t depth, size_t bytes);
+    void refuse(size_t y);
 
     const TraceScene& scene_;
     const size_t maxBytes_;
@@ -67,6 +96,9 @@ class UnrollCache {
     std::unique_ptr<Yield[]> yield_;
     std::atomic<size_t> bytes_{0}, entries_{0};
     std::atomic<uint64_t> expansions_{0};
+    // The bytes of the expansions so far, and the visits InstanceBoxes gave for them
+    // (bytes per visit, for the estimate of predictedTooLarge).
+    std::atomic<uint64_t> builtBytes_{0}, builtWeight_{0};
     std::mutex queueMutex_;
     std::deque<InstanceBoxes::Key> queue_;  // every entry, in the order of insertion
     DeferredFree retired_;

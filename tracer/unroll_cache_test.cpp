@@ -1,11 +1,15 @@
 // The shared cache of expanded instances (unroll_cache.h): threads asking for the same
 // instance get one object, built once; the cache stays within its byte budget whatever
 // the threads do; an instance evicted while a reader is pinned stays intact until the
-// reader unpins; tracers on several threads find the same hits as the graph walk.
+// reader unpins; tracers on several threads find the same hits as the graph walk; an
+// instance larger than its share of the budget is refused and the level below it is
+// expanded instead; levels of large instances that do not stay, and levels whose
+// instances are rebuilt after eviction, stop expanding.
 #include "unroll_cache.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <thread>
 
@@ -41,15 +45,22 @@ struct Flower {
         for (size_t k = 0; k < frame.size(); ++k)
             if (frame[k] == 21) slot = k;
     }
-    const UnrolledInstance* get(UnrollCache::Reader& r, int petals) {
+    const UnrolledInstance* get(UnrollCache::Reader& r, double petals, uint32_t depth = 1) {
         frame[slot] = petals;
-        return r.get(select, 1, frame.data(), kRootPath);
+        return r.get(select, depth, frame.data(), kRootPath);
     }
     const Graph& g;
     std::vector<double> frame;
     NodeId select = kNone;
     size_t slot = SIZE_MAX;
 };
+
+// The bytes of the flower's instance with p petals, expanded alone.
+size_t flowerBytes(const TraceScene& scene, Flower& f, double p) {
+    f.frame[f.slot] = p;
+    return UnrolledInstance::expand(scene, f.select, 1, f.frame.data(), kRootPath, 1u << 20)
+        ->bytes();
+}
 
 // The nearest hit of a ray through an instance, to compare instances by what they hold.
 Hit hitOf(const UnrolledInstance& x, UnrollCache::Reader& r) {
@@ -88,9 +99,10 @@ TEST(UnrollCache, AnInstanceEvictedWhileInUseStaysIntactUntilItsReaderUnpins) {
     auto c = compile(kFlower);
     ASSERT_TRUE(c->graph);
     TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
-    UnrollCache cache(scene, 2048);  // room for notes and small instances
     Flower fa(*c->graph), fb(*c->graph);
     ASSERT_NE(fa.slot, SIZE_MAX);
+    // Room for the whole flower (within its share), not for it and all the smaller ones.
+    UnrollCache cache(scene, 8 * (flowerBytes(scene, fa, 21) + 256));
     UnrollCache::Reader a(cache);
     auto b = std::make_unique<UnrollCache::Reader>(cache);
     const UnrolledInstance* x = nullptr;
@@ -101,12 +113,15 @@ TEST(UnrollCache, AnInstanceEvictedWhileInUseStaysIntactUntilItsReaderUnpins) {
         const Hit before = hitOf(*x, a);
         ASSERT_TRUE(before.valid);
         const Box box = x->box();
-        // Another reader fills the cache: the instance leaves it, but is not freed.
-        for (int p = 1; p < 21; ++p)
-            for (int i = 0; i < 2; ++i) {
-                const UnrollCache::Pin pinB(b.get());
-                fb.get(*b, p);
-            }
+        // Another reader fills the cache: the instance leaves it, but is not freed. (At three
+        // depths, each with flowers of its own: a depth stops after half the budget's worth
+        // of large instances.)
+        for (uint32_t depth = 2; depth <= 4; ++depth)
+            for (int p = 1; p < 21; ++p)
+                for (int i = 0; i < 2; ++i) {
+                    const UnrollCache::Pin pinB(b.get());
+                    fb.get(*b, p + depth / 4.0, depth);
+                }
         EXPECT_GT(cache.retiredBytes(), 0u);
         const Hit after = hitOf(*x, a);  // (ASan: a use after free if it had been freed)
         EXPECT_EQ(after.t, before.t);
@@ -169,6 +184,120 @@ TEST(UnrollCache, TracersOnSeveralThreadsStayWithinOneBudgetAndFindTheGraphWalks
     EXPECT_GT(cache.bytes(), 0u);
     EXPECT_LE(cache.bytes(), cache.maxBytes()) << cache.entries() << " entries";
     EXPECT_EQ(cache.retiredBytes(), 0u);  // the tracers are gone: nothing is held
+}
+
+// The Sierpinski tetrahedron of order 4: one instance per depth, each four times the size
+// of the one below.
+const char* kTetra = R"(
+{c = 4} S
+S if(c > 0, 2, 1)
+1: S -> tetrahedron
+2: S -> {c = c-1} (move(0.5,0.5,0.5) uscale(0.5) S ∪ move(-0.5,-0.5,0.5) uscale(0.5) S ∪
+                   move(0.5,-0.5,-0.5) uscale(0.5) S ∪ move(-0.5,0.5,-0.5) uscale(0.5) S)
+)";
+
+TEST(UnrollCache, AnInstanceLargerThanItsShareIsRefusedAndTheLevelBelowIsExpandedInstead) {
+    auto c = compile(kTetra);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene plain(g, computeBounds(g), true, eagerExpansion());
+    plain.expansionBytes = 0;
+    TraceScene scene(g, computeBounds(g), true, eagerExpansion());
+    // The budget's share holds the instance at depth 2 (order 3), not the one at depth 1.
+    std::vector<double> root(g.slotCount()), frame(g.slotCount());
+    initFrame(g, root.data());
+    applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, frame.data());
+    const NodeId select = g.child(g.axiom);
+    const auto order = std::find(frame.begin(), frame.end(), 4.0);
+    ASSERT_NE(order, frame.end());
+    auto bytesAt = [&](double c) {
+        *order = c;
+        return UnrolledInstance::expand(scene, select, 1, frame.data(), kRootPath, 1u << 20)
+            ->bytes();
+    };
+    const size_t whole = bytesAt(4), quarter = bytesAt(3);
+    scene.expansionBytes = 8 * (quarter + 1024);
+    ASSERT_GT(whole, scene.expansionBytes / 8);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    Tracer walk(plain), tracer(scene);
+    int mismatches = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 o{u(rng) * 5, -6 + u(rng), u(rng) * 5};
+        const Vec3 d = normalize(Vec3{u(rng), u(rng), u(rng)} - o);
+        for (int round = 0; round < 2; ++round) {
+            SurfaceHit a, b;
+            const bool fa = walk.firstHit(o, d, 1e-4, 1e7, a);
+            const bool fb = tracer.firstHit(o, d, 1e-4, 1e7, b);
+            if (fa != fb || (fa && (a.t != b.t || a.normal.x != b.normal.x))) ++mismatches;
+        }
+    }
+    EXPECT_EQ(mismatches, 0);
+    const UnrollCache& cache = scene.expansionCache();
+    const UnrollCache::Level one = cache.level(select, 1), two = cache.level(select, 2);
+    EXPECT_TRUE(one.off);
+    EXPECT_EQ(one.built, 0u);
+    EXPECT_FALSE(two.off);
+    EXPECT_EQ(two.built, 1u);  // (one instance: the four at depth 2 are alike)
+    EXPECT_GT(cache.bytes(), quarter);
+    EXPECT_LE(cache.bytes(), cache.maxBytes());
+}
+
+TEST(UnrollCache, ALevelWhoseLargeInstancesDoNotStayStopsExpanding) {
+    auto c = compile(kFlower);
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
+    Flower f(*c->graph);
+    ASSERT_NE(f.slot, SIZE_MAX);
+    // Flowers of 21 petals (20.001, 20.002, ...: each an instance of its own), each a 40th of
+    // the budget: large (over a 64th), and 60 of them hold more than half the budget.
+    const size_t each = flowerBytes(scene, f, 20.5);
+    UnrollCache cache(scene, 40 * each);
+    UnrollCache::Reader reader(cache);
+    uint64_t built = 0, refusedAfterStop = 0;
+    for (int i = 1; i <= 60; ++i) {
+        const UnrollCache::Pin pin(&reader);
+        const double p = 20 + i / 1000.0;
+        const bool wasOff = cache.level(f.select, 1).off;
+        f.get(reader, p);
+        const UnrolledInstance* x = f.get(reader, p);
+        if (x) ++built;
+        if (wasOff && !x) ++refusedAfterStop;
+        EXPECT_LE(cache.bytes(), cache.maxBytes()) << "flower " << i;
+    }
+    const UnrollCache::Level level = cache.level(f.select, 1);
+    EXPECT_TRUE(level.off);
+    EXPECT_EQ(level.built, built);
+    EXPECT_GE(built, 20u);  // half the budget's worth was built, not much more
+    EXPECT_LE(built, 22u);
+    EXPECT_EQ(refusedAfterStop, 60 - built);
+    EXPECT_EQ(level.refused, 0u);
+}
+
+TEST(UnrollCache, ALevelWhoseInstancesAreRebuiltAfterEvictionStopsExpanding) {
+    auto c = compile(kFlower);
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
+    Flower f(*c->graph);
+    ASSERT_NE(f.slot, SIZE_MAX);
+    // Small flowers of 2 petals (1.001, 1.002, ...), well used, but half as many again as
+    // the cache holds, met again and again.
+    const size_t each = flowerBytes(scene, f, 1.5);
+    UnrollCache cache(scene, 100 * (each + 128));
+    UnrollCache::Reader reader(cache);
+    int pass = 0;
+    for (; pass < 6 && !cache.level(f.select, 1).off; ++pass)
+        for (int i = 1; i <= 150; ++i)
+            for (int use = 0; use < 8; ++use) {
+                const UnrollCache::Pin pin(&reader);
+                f.get(reader, 1 + i / 1000.0);
+                EXPECT_LE(cache.bytes(), cache.maxBytes());
+            }
+    const UnrollCache::Level level = cache.level(f.select, 1);
+    EXPECT_TRUE(level.off);
+    EXPECT_GE(pass, 2) << level.built << " " << level.rebuilt;  // (the first pass builds each once)
+    EXPECT_GT(level.rebuilt * 3, level.built - level.rebuilt);
+    EXPECT_EQ(level.refused, 0u);
 }
 
 }  // namespace
