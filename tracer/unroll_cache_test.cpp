@@ -203,7 +203,9 @@ TEST(UnrollCache, AnInstanceLargerThanItsShareIsRefusedAndTheLevelBelowIsExpande
     TraceScene plain(g, computeBounds(g), true, eagerExpansion());
     plain.expansionBytes = 0;
     TraceScene scene(g, computeBounds(g), true, eagerExpansion());
-    // The budget's share holds the instance at depth 2 (order 3), not the one at depth 1.
+    // The budget's share holds the instance at depth 2 (order 3), twice over, not the one
+    // at depth 1 (four times as large): the margin leaves room for the cache's estimate of
+    // a level's size before its first expansion.
     std::vector<double> root(g.slotCount()), frame(g.slotCount());
     initFrame(g, root.data());
     applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, frame.data());
@@ -216,7 +218,7 @@ TEST(UnrollCache, AnInstanceLargerThanItsShareIsRefusedAndTheLevelBelowIsExpande
             ->bytes();
     };
     const size_t whole = bytesAt(4), quarter = bytesAt(3);
-    scene.expansionBytes = 8 * (quarter + 1024);
+    scene.expansionBytes = 8 * 2 * quarter;
     ASSERT_GT(whole, scene.expansionBytes / 8);
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> u(-1, 1);
