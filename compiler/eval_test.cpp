@@ -7,24 +7,12 @@
 #include <random>
 #include <set>
 
+#include "raw_code_test_util.h"
+
 namespace pcsg {
 namespace {
 
-// Appends an expression made of raw instructions.
-ExprId addCode(Graph& g, std::vector<Instr> code, uint32_t maxStack, std::string text = "expr") {
-    Expr e;
-    e.begin = static_cast<uint32_t>(g.code.size());
-    for (auto& in : code) {
-        if (in.op == Op::Jump || in.op == Op::JumpIfZero) in.a += e.begin;
-        g.code.push_back(in);
-    }
-    e.end = static_cast<uint32_t>(g.code.size());
-    e.maxStack = maxStack;
-    e.text = std::move(text);
-    e.loc = {0, 7, 3};
-    g.exprs.push_back(e);
-    return static_cast<ExprId>(g.exprs.size() - 1);
-}
+using testing::addCode;
 
 std::vector<double> frameOf(const Graph& g) {
     std::vector<double> f(g.slotCount());

@@ -12,9 +12,12 @@
 
 #include "compile_test_util.h"
 #include "eval.h"
+#include "raw_code_test_util.h"
 
 namespace pcsg {
 namespace {
+
+using testing::addCode;
 
 // Scenes whose C-node assigns r1, r2, ... the expressions under test (the axiom's sets x, y,
 // z so that they compile, unfolded, so that they stay parameters; w is assigned on
@@ -255,25 +258,11 @@ TEST(FastCode, ChooseWeightErrorsAreReportedAsThePlainCodeReportsThem) {
     EXPECT_EQ(run(g, 1, 2), "");
 }
 
-// Appends raw plain code as an expression (as eval_test.cpp does).
-ExprId addCode(Graph& g, std::vector<Instr> code) {
-    Expr e;
-    e.begin = static_cast<uint32_t>(g.code.size());
-    for (auto& in : code) {
-        if (in.op == Op::Jump || in.op == Op::JumpIfZero) in.a += e.begin;
-        g.code.push_back(in);
-    }
-    e.end = static_cast<uint32_t>(g.code.size());
-    e.maxStack = static_cast<uint32_t>(code.size());
-    g.exprs.push_back(e);
-    return static_cast<ExprId>(g.exprs.size() - 1);
-}
-
 TEST(FastCode, CodeTheMachineCannotRunStaysPlain) {
     Graph g;
-    const ExprId two = addCode(g, {{Op::Const, 0, 0, 1}, {Op::Const, 0, 0, 2}});  // two values
-    const ExprId none = addCode(g, {});
-    const ExprId ok = addCode(g, {{Op::Const, 0, 0, 1}, {Op::Const, 0, 0, 2}, {Op::Sub}});
+    const ExprId two = addCode(g, {{Op::Const, 0, 0, 1}, {Op::Const, 0, 0, 2}}, 2);  // two values
+    const ExprId none = addCode(g, {}, 0);
+    const ExprId ok = addCode(g, {{Op::Const, 0, 0, 1}, {Op::Const, 0, 0, 2}, {Op::Sub}}, 2);
     buildFastCode(g);
     EXPECT_EQ(g.exprs[two].fast, kNoFast);
     EXPECT_EQ(g.exprs[none].fast, kNoFast);
@@ -288,8 +277,8 @@ TEST(FastCode, SimultaneousCalcsReadTheIncomingFrame) {
     Graph g;
     const Slot a = g.slot("a"), b = g.slot("b");
     // {a = b + 1; b = a * 10}, in order and together
-    const ExprId e1 = addCode(g, {{Op::Load, 0, b, 0}, {Op::Const, 0, 0, 1}, {Op::Add}});
-    const ExprId e2 = addCode(g, {{Op::Load, 0, a, 0}, {Op::Const, 0, 0, 10}, {Op::Mul}});
+    const ExprId e1 = addCode(g, {{Op::Load, 0, b, 0}, {Op::Const, 0, 0, 1}, {Op::Add}}, 2);
+    const ExprId e2 = addCode(g, {{Op::Load, 0, a, 0}, {Op::Const, 0, 0, 10}, {Op::Mul}}, 2);
     g.assignments = {{a, e1}, {b, e2}};
     g.calcs.push_back(Calc{0, 2, false});
     g.calcs.push_back(Calc{0, 2, true});
