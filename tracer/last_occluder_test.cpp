@@ -17,13 +17,7 @@ using testing::compile;
 
 // A Sierpinski tetrahedron of order 6: the default options expand the copies a few
 // levels down, below T-nodes (the occluder's chain of matrices is not empty).
-const char* kOrder6 = R"(
-{c = 6} S
-S if(c > 0, 2, 1)
-1: S -> tetrahedron
-2: S -> {c = c-1} ( move(0.5,0.5,0.5) uscale(0.5) S ∪ move(-0.5,-0.5,0.5) uscale(0.5) S ∪
-                    move(0.5,-0.5,-0.5) uscale(0.5) S ∪ move(-0.5,0.5,-0.5) uscale(0.5) S )
-)";
+const std::string kOrder6 = testing::sierpinski(6);
 
 // Shadow rays toward two lights from the surface points of a grid of camera rays, in
 // pixel order (neighbours share occluders), twice (the second time through expansions):

@@ -173,12 +173,29 @@ inline size_t expectSameBoxes(const Graph& g, const InstanceBoxes& a, const Inst
 }
 
 // A few systems from the paper and beyond, shared by the tests.
-inline const char* kSierpinski = R"(
-{c = 4} S
+
+// The Sierpinski tetrahedron of the given order: one instance per depth, each four times
+// the size of the one below.
+inline std::string sierpinski(int order) {
+    return "\n{c = " + std::to_string(order) + R"(} S
 S if(c > 0, 2, 1)
 1: S -> tetrahedron
 2: S -> {c = c-1} ( move(0.5,0.5,0.5) uscale(0.5) S ∪ move(-0.5,-0.5,0.5) uscale(0.5) S ∪
                     move(0.5,-0.5,-0.5) uscale(0.5) S ∪ move(-0.5,0.5,-0.5) uscale(0.5) S )
+)";
+}
+inline const std::string kSierpinskiText = sierpinski(4);
+inline const char* const kSierpinski = kSierpinskiText.c_str();  // (order 4)
+
+// A flower head of p petals: 21 petals as a chain of unions 21 deep, each a rotation
+// further on; each value of p is an instance of its own.
+inline const char* const kFlower = R"(
+material petal { color <1, 1, 0.9> }
+{p = 21} F
+F if(p > 0, 2, 1)
+1: F -> scale(0.2, 0.2, 0.1) sphere
+2: F -> paint(petal) roty(-12 - 10*mod(p, 2)) move(0.45, 0, 0) scale(0.36, 0.08, 0.02) sphere ∪
+        {p = p-1} rotz(360/21) F
 )";
 
 }  // namespace pcsg::tracer::testing

@@ -23,15 +23,7 @@ namespace {
 using testing::compile;
 using testing::eagerExpansion;
 
-// A flower head of p petals: each value of p is an instance of its own.
-const char* kFlower = R"(
-material petal { color <1, 1, 0.9> }
-{p = 21} F
-F if(p > 0, 2, 1)
-1: F -> scale(0.2, 0.2, 0.1) sphere
-2: F -> paint(petal) roty(-12 - 10*mod(p, 2)) move(0.45, 0, 0) scale(0.36, 0.08, 0.02) sphere ∪
-        {p = p-1} rotz(360/21) F
-)";
+using testing::kFlower;
 
 const std::string kPlant = testing::branchingPlant(6);
 
@@ -186,18 +178,8 @@ TEST(UnrollCache, TracersOnSeveralThreadsStayWithinOneBudgetAndFindTheGraphWalks
     EXPECT_EQ(cache.retiredBytes(), 0u);  // the tracers are gone: nothing is held
 }
 
-// The Sierpinski tetrahedron of order 4: one instance per depth, each four times the size
-// of the one below.
-const char* kTetra = R"(
-{c = 4} S
-S if(c > 0, 2, 1)
-1: S -> tetrahedron
-2: S -> {c = c-1} (move(0.5,0.5,0.5) uscale(0.5) S ∪ move(-0.5,-0.5,0.5) uscale(0.5) S ∪
-                   move(0.5,-0.5,-0.5) uscale(0.5) S ∪ move(-0.5,0.5,-0.5) uscale(0.5) S)
-)";
-
 TEST(UnrollCache, AnInstanceLargerThanItsShareIsRefusedAndTheLevelBelowIsExpandedInstead) {
-    auto c = compile(kTetra);
+    auto c = compile(testing::kSierpinski);  // order 4
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
     TraceScene plain(g, computeBounds(g), true, eagerExpansion());

@@ -139,19 +139,9 @@ TEST(ExpandedInstances, AxisParallelRaysHitTheSameSurfacesBitForBit) {
     EXPECT_GT(compareWithGraphWalk(testing::kSierpinski, r, 400), 0u);
 }
 
-// A flower head: 21 petals as a chain of unions 21 deep, each a rotation further on.
-const char* kChain = R"(
-material petal { color <1, 1, 0.9> }
-{p = 21} F
-F if(p > 0, 2, 1)
-1: F -> scale(0.2, 0.2, 0.1) sphere
-2: F -> paint(petal) roty(-12 - 10*mod(p, 2)) move(0.45, 0, 0) scale(0.36, 0.08, 0.02) sphere ∪
-        {p = p-1} rotz(360/21) F
-)";
-
 TEST(ExpandedInstances, AChainOfUnionsGetsAHierarchyAndTheSameHits) {
-    EXPECT_GT(compareWithGraphWalk(kChain, 0.6, 100), 0u);
-    auto c = compile(kChain);
+    EXPECT_GT(compareWithGraphWalk(testing::kFlower, 0.6, 100), 0u);
+    auto c = compile(testing::kFlower);
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
     TraceScene scene(g, computeBounds(g), true, eagerExpansion());
