@@ -318,6 +318,10 @@ class InstanceBoxes::CountingWorker : public WorkerOf<BoxSinkOf<CountedBoxResult
 
 InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
                              const InstanceBoxOptions& options)
+    : InstanceBoxes(g, bounds, options, FixedSlots(g)) {}
+
+InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
+                             const InstanceBoxOptions& options, const FixedSlots& fixed)
     : g_(g),
       sem_(g),
       bounds_(bounds),
@@ -329,7 +333,7 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
       levels_(g.scene.settings.maxDepth + 2) {
     if (sequence_ && &sequence_->g_ != &g)
         throw std::logic_error("InstanceBoxes: the sequence's boxes belong to another graph");
-    narrowKeySlots(g, deps_);  // keys hash only the parameters that tell instances apart
+    narrowKeySlots(g, fixed, deps_);  // keys hash only the parameters that tell instances apart
     for (size_t m = 0; m < lasting_.size() && sequence_; ++m)
         lasting_[m] = deps_[m].analysed && !deps_[m].usesTime;
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);

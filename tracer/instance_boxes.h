@@ -45,6 +45,7 @@
 #include <vector>
 
 #include "bounds.h"
+#include "fixed_slots.h"
 #include "geometry.h"
 #include "graph.h"
 #include "semantics.h"
@@ -86,6 +87,9 @@ struct InstanceBoxStats {
 class InstanceBoxes {
   public:
     InstanceBoxes(const Graph& g, const Bounds& bounds, const InstanceBoxOptions& options = {});
+    // With the graph's fixed slots already found (TraceScene's, which its memo plan uses).
+    InstanceBoxes(const Graph& g, const Bounds& bounds, const InstanceBoxOptions& options,
+                  const FixedSlots& fixed);
     ~InstanceBoxes();
     InstanceBoxes(const InstanceBoxes&) = delete;
     InstanceBoxes& operator=(const InstanceBoxes&) = delete;

@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "fixed_slots.h"
-
 namespace pcsg::tracer {
 
 namespace {
@@ -123,11 +121,11 @@ bool liveSlots(const Graph& g, SlotSets& live) {
 
 }  // namespace
 
-void narrowKeySlots(const Graph& g, std::vector<ModuleDependencies>& deps) {
+void narrowKeySlots(const Graph& g, const FixedSlots& fixed,
+                    std::vector<ModuleDependencies>& deps) {
     if (static_cast<uint64_t>(g.nodes.size()) * (g.slotCount() + 64) > kMaxWork) return;
     SlotSets live(g.nodes.size(), g.slotCount());
     if (!liveSlots(g, live)) return;
-    const FixedSlots fixed(g);
     for (size_t m = 0; m < deps.size() && m < g.modules.size(); ++m) {
         const NodeId s = g.modules[m].node;
         if (!deps[m].analysed || s >= g.nodes.size()) continue;

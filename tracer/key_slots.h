@@ -17,13 +17,14 @@
 
 #include <vector>
 
+#include "fixed_slots.h"
 #include "graph.h"
 #include "walk.h"
 
 namespace pcsg::tracer {
 
-// Removes the dead and fixed slots from each analysed module's `reads`. Leaves `deps`
-// as it is when the graph is too large to analyse cheaply.
-void narrowKeySlots(const Graph& g, std::vector<ModuleDependencies>& deps);
+// Removes the dead slots and the `fixed` ones from each analysed module's `reads`. Leaves
+// `deps` as it is when the graph is too large to analyse cheaply.
+void narrowKeySlots(const Graph& g, const FixedSlots& fixed, std::vector<ModuleDependencies>& deps);
 
 }  // namespace pcsg::tracer

@@ -17,7 +17,7 @@ using testing::compile;
 // The names of the slots the key of module `name` hashes, after narrowing.
 std::vector<std::string> keyed(const Graph& g, const std::string& name) {
     std::vector<ModuleDependencies> deps = moduleDependencies(g);
-    narrowKeySlots(g, deps);
+    narrowKeySlots(g, FixedSlots(g), deps);
     for (size_t m = 0; m < g.modules.size(); ++m) {
         if (g.modules[m].name != name) continue;
         EXPECT_TRUE(deps[m].analysed);

@@ -63,23 +63,21 @@ void TraceScene::markPaintFrames() {
     if (any) paintFrames = std::move(marks);
 }
 
-namespace {
-// The tracer's walks all start at the axiom: their memo keys leave out the fixed slots
-// (the terrain's C-nodes then read few enough values to be memoised at all).
-StepMemoPlan axiomMemoPlan(const Graph& g) {
-    const FixedSlots fixed(g);
-    return StepMemoPlan(g, &fixed);
-}
-}  // namespace
-
 TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
                        const InstanceBoxOptions& instanceBoxOptions)
-    : g_(g), sem_(g), memoPlan_(axiomMemoPlan(g)), bounds_(std::move(bounds)) {
+    : TraceScene(g, std::move(bounds), useInstanceBoxes, instanceBoxOptions, FixedSlots(g)) {}
+
+// The tracer's walks all start at the axiom: their memo keys and the instance keys leave
+// out the fixed slots (the terrain's C-nodes then read few enough values to be memoised
+// at all).
+TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
+                       const InstanceBoxOptions& instanceBoxOptions, const FixedSlots& fixed)
+    : g_(g), sem_(g), memoPlan_(g, &fixed), bounds_(std::move(bounds)) {
     const size_t n = g.nodes.size();
     if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
     markPaintFrames();
     if (useInstanceBoxes && !g.modules.empty())
-        instanceBoxes_ = std::make_unique<InstanceBoxes>(g, bounds_, instanceBoxOptions);
+        instanceBoxes_ = std::make_unique<InstanceBoxes>(g, bounds_, instanceBoxOptions, fixed);
     // Longest chain of nested visits between two S-nodes (the graph without the edges into
     // S-nodes is acyclic), then the whole walk's bound.
     std::vector<uint32_t> indeg(n, 0), order;

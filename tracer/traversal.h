@@ -132,6 +132,8 @@ class TraceScene {
 
   private:
     friend class Tracer;
+    TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
+               const InstanceBoxOptions& instanceBoxOptions, const FixedSlots& fixed);
     void markPaintFrames();
     const Graph& g_;
     Semantics sem_;
