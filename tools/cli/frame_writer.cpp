@@ -24,8 +24,7 @@ std::vector<uint8_t> parallelSrgbBytes(std::span<const float> rgb, int threads) 
     arena.execute([&] {
         tbb::parallel_for(size_t{0}, (rgb.size() + kChunk - 1) / kChunk, [&](size_t chunk) {
             const size_t begin = chunk * kChunk, n = std::min(kChunk, rgb.size() - begin);
-            const std::vector<uint8_t> part = srgbBytes(rgb.subspan(begin, n));
-            std::copy(part.begin(), part.end(), bytes.begin() + static_cast<ptrdiff_t>(begin));
+            srgbBytesInto(rgb.subspan(begin, n), std::span(bytes).subspan(begin, n));
         });
     });
     return bytes;

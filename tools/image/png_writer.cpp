@@ -119,10 +119,14 @@ class SrgbTable {
 
 }  // namespace
 
-std::vector<uint8_t> srgbBytes(std::span<const float> rgb) {
+void srgbBytesInto(std::span<const float> rgb, std::span<uint8_t> out) {
     static const SrgbTable table;
+    for (size_t i = 0; i < rgb.size() && i < out.size(); ++i) out[i] = table(rgb[i]);
+}
+
+std::vector<uint8_t> srgbBytes(std::span<const float> rgb) {
     std::vector<uint8_t> bytes(rgb.size());
-    for (size_t i = 0; i < rgb.size(); ++i) bytes[i] = table(rgb[i]);
+    srgbBytesInto(rgb, bytes);
     return bytes;
 }
 

@@ -13,6 +13,8 @@ namespace pcsg::tools {
 // The 8-bit sRGB values of linear RGB floats: round(srgbEncode(v) * 255) each, the one
 // encoding of every 8-bit image pcsg writes.
 std::vector<uint8_t> srgbBytes(std::span<const float> rgb);
+// The same into `out` (as many values as both hold), for callers that split the image.
+void srgbBytesInto(std::span<const float> rgb, std::span<uint8_t> out);
 
 // Writes linear RGB pixels (row-major from the top-left, width * height * 3 floats) as an
 // 8-bit sRGB PNG. Writes to a temporary file beside the target and renames it, so a
