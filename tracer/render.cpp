@@ -106,7 +106,8 @@ class TileRender {
           halo_(opt.adaptive > 0 ? Region{std::max(0, region.x0 - 1), std::max(0, region.y0 - 1),
                                           std::min(w_, region.x1 + 1), std::min(h_, region.y1 + 1)}
                                  : region),
-          totalWork_(tileCount(halo_) + (opt.adaptive > 0 ? tileCount(region_) : 0)) {
+          totalWork_(tileCount(halo_) + (opt.adaptive > 0 ? tileCount(region_) : 0)),
+          near_(opt.adaptive) {
         rgb_.assign(halo_.pixels() * 3, 0.0f);
     }
 
@@ -259,14 +260,21 @@ class TileRender {
     }
 
     // Adaptive sampling (POV-Ray's +A, method 1): whether pixel (x, y)'s centre differs
-    // from a 4-neighbour's by the threshold or more. Reads pass 1's centres.
+    // from a 4-neighbour's by the threshold or more. Reads pass 1's centres; encodes them
+    // only where a neighbour is not near (NearColours), which most pixels are not.
     bool differsFromNeighbour(Worker& wk, uint64_t pass, int x, int y) const {
+        const float* p = pixelAt(rgb_, x, y);
+        const ptrdiff_t row = static_cast<ptrdiff_t>(halo_.width()) * 3;
+        // (a neighbour outside the image is the pixel itself, which is near)
+        if (near_(p, x > 0 ? p - 3 : p) && near_(p, x + 1 < w_ ? p + 3 : p) &&
+            near_(p, y > 0 ? p - row : p) && near_(p, y + 1 < h_ ? p + row : p))
+            return false;
+        const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
         const double* encoded = encodedTile(wk, pass, x, y);
         auto at = [&](int px, int py) {  // (the neighbours of the tile's pixels are in area)
             return encoded +
                    (static_cast<size_t>(py - wk.area.y0) * wk.area.width() + (px - wk.area.x0)) * 3;
         };
-        const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
         for (int k = 0; k < 4; ++k) {
             if (nx[k] < 0 || nx[k] >= w_ || ny[k] < 0 || ny[k] >= h_) continue;
             if (colourDistance(at(x, y), at(nx[k], ny[k])) >= opt_.adaptive) return true;
@@ -295,6 +303,7 @@ class TileRender {
     const int w_, h_;
     const Region region_, halo_;
     const int totalWork_;
+    const NearColours near_;  // neighbours that cannot differ at the threshold
     std::vector<float> rgb_;  // halo_'s pixels
     std::mutex errorMutex_;
     std::exception_ptr firstError_;
