@@ -127,7 +127,13 @@ class SrgbTable {
 
 void srgbBytesInto(std::span<const float> rgb, std::span<uint8_t> out) {
     static const SrgbTable table;
-    for (size_t i = 0; i < rgb.size() && i < out.size(); ++i) out[i] = table(rgb[i]);
+    const size_t n = std::min(rgb.size(), out.size());
+    // A value is mostly the one three before it (the same channel of the pixel to the left:
+    // the sky, flat faces), whose byte is known: the same float bits, the same byte.
+    for (size_t i = 0; i < n; ++i)
+        out[i] = i >= 3 && std::bit_cast<uint32_t>(rgb[i]) == std::bit_cast<uint32_t>(rgb[i - 3])
+                     ? out[i - 3]
+                     : table(rgb[i]);
 }
 
 std::vector<uint8_t> srgbBytes(std::span<const float> rgb) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -58,6 +59,26 @@ TEST(PngWriter, TheTableGivesTheFormulasBytes) {
     for (size_t i = 0; i < values.size(); ++i)
         wrong += bytes[i] != static_cast<uint8_t>(std::lround(srgbEncode(values[i]) * 255.0));
     EXPECT_EQ(wrong, 0u);
+}
+
+// Runs of equal values (a flat sky) take the byte of the value three before them: still
+// the formula's bytes, for runs, alternations, values equal but for their bits (0 and -0,
+// NaNs) and spans that start anywhere.
+TEST(PngWriter, RepeatedValuesGiveTheFormulasBytes) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<float> values;
+    for (float v : {0.3f, 0.3f, 0.3f, 0.3f, 0.7f, 0.3f, 0.3f,  0.0f,  -0.0f, 0.0f,  0.5f,  -0.0f,
+                    nan,  0.2f, 0.9f, nan,  2.0f, 0.9f, 0.01f, 0.01f, 0.01f, 0.02f, 0.01f, 0.01f})
+        values.push_back(v);
+    for (int i = 0; i < 300; ++i) values.push_back(i % 7 < 4 ? 0.25f : 0.001f * i);
+    auto formula = [](float v) { return static_cast<uint8_t>(std::lround(srgbEncode(v) * 255.0)); };
+    for (size_t start : {size_t{0}, size_t{1}, size_t{2}, size_t{5}}) {
+        const std::span<const float> part = std::span(values).subspan(start);
+        std::vector<uint8_t> bytes(part.size(), 77);
+        srgbBytesInto(part, bytes);
+        for (size_t i = 0; i < part.size(); ++i)
+            ASSERT_EQ(bytes[i], formula(part[i])) << "value " << start + i;
+    }
 }
 
 TEST(PngWriter, OpenImageIOReadsBackWhatWasWritten) {
