@@ -22,6 +22,37 @@ inline double colourDistance(const double* a, const double* b) {
     return d;
 }
 
+// Two pixels' colours (linear, three floats each) too close to differ at the threshold:
+// NearColours(T)(a, b) true guarantees that colourDistance(aaEncode(a), aaEncode(b)) >= T
+// is false, so the decision can skip the encoding for pixels whose neighbours are all near
+// (the sky, a smoothly lit floor). Colours with the same bits are near (their distance is
+// 0, or NaN for infinities). Otherwise the bound: for u, v >= 0, |u^0.4 - v^0.4| <=
+// |u - v|^0.4 (x^0.4 is concave and 0 at 0), and aaEncode clamps below 0, which only brings
+// values closer; with every channel within m = (T/6)^2.5 the distance is at most
+// 3 (T/6) = T/2, a margin far beyond pow's rounding. A NaN or an infinity is then never
+// near (the caller encodes as before), and neither is anything for a threshold under
+// 1e-6, where the margin would shrink towards the rounding.
+class NearColours {
+  public:
+    explicit NearColours(double threshold)
+        : bound_(threshold >= 1e-6 ? std::pow(threshold / 6, 2.5) : -1.0) {}
+    bool operator()(const float* a, const float* b) const {
+        if (std::bit_cast<uint32_t>(a[0]) == std::bit_cast<uint32_t>(b[0]) &&
+            std::bit_cast<uint32_t>(a[1]) == std::bit_cast<uint32_t>(b[1]) &&
+            std::bit_cast<uint32_t>(a[2]) == std::bit_cast<uint32_t>(b[2]))
+            return true;
+        for (int k = 0; k < 3; ++k) {
+            const double d = static_cast<double>(a[k]) - static_cast<double>(b[k]);
+            if (!(std::fabs(d) <= bound_)) return false;
+        }
+        return true;
+    }
+    double bound() const { return bound_; }
+
+  private:
+    double bound_;
+};
+
 // aaEncode of float channels, remembering the last values met in a small direct-mapped
 // table keyed by the float's bits: exactly aaEncode's doubles, for a few instructions
 // where a neighbouring pixel had the same value (the sky, a flat-shaded face), instead of

@@ -85,6 +85,39 @@ TEST(Render, SameBytesWhateverTheThreadCount) {
     }
 }
 
+// Each pixel is the average of its own samples, bit for bit, though the render makes a
+// row's camera rays (aa 1) or a pixel's (aa 5: 25 samples, more than one batch of rays)
+// before it shades them: a ray shaded for the wrong pixel or sample fails (the order of
+// the sum mostly cannot be seen once the colour is a float).
+TEST(Render, EachPixelIsItsOwnSamplesWhenRaysAreMadeInBatches) {
+    auto c = compile(kBusyScene);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene scene(g, computeBounds(g));
+    Shader shader(scene);
+    for (int aa : {1, 5}) {
+        RenderOptions o = small(2);
+        o.width = 37;  // rows of two tiles and a part
+        o.aa = aa;
+        const RenderResult r = render(g, o);
+        const PinholeCamera camera(g.scene.camera, o.width, o.height);
+        int wrong = 0;
+        for (int y = 0; y < o.height; ++y)
+            for (int x = 0; x < o.width; ++x) {
+                Vec3 sum{0, 0, 0};
+                for (int j = 0; j < aa; ++j)
+                    for (int i = 0; i < aa; ++i)
+                        sum += shader.shade(camera.ray(x + (i + 0.5) / aa, y + (j + 0.5) / aa));
+                sum = sum / static_cast<double>(aa * aa);
+                const float want[3] = {static_cast<float>(sum.x), static_cast<float>(sum.y),
+                                       static_cast<float>(sum.z)};
+                const float* got = &r.rgb[(static_cast<size_t>(y) * o.width + x) * 3];
+                wrong += std::memcmp(want, got, sizeof want) != 0;
+            }
+        EXPECT_EQ(wrong, 0) << "aa " << aa;
+    }
+}
+
 TEST(Render, CullingNeverChangesTheImage) {
     auto c = compile(kBusyScene);
     ASSERT_TRUE(c->graph);

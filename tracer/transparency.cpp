@@ -27,7 +27,7 @@ bool Interiors::remove(uint64_t id) {
 }
 
 void Interiors::push(const Interior& interior) {
-    if (size_ < kCapacity) items_[size_++] = interior;
+    if (size_ < kCapacity) items_[size_++] = Slot{interior.id, interior.material};
 }
 
 double iorOf(const Graph& g, uint32_t material) {

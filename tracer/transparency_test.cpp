@@ -32,6 +32,38 @@ TEST(Transparency, RefractionFollowsSnellsLaw) {
     }
 }
 
+// An interior stack copies only the interiors in use: a copy and an assignment (onto a
+// deeper stack, whose old slots must not show through) hold the same interiors, innermost
+// last, and change apart from the original.
+TEST(Transparency, InteriorStacksCopyTheInteriorsInUse) {
+    Interiors a;
+    for (uint64_t id : {11, 22, 33}) a.push(Interior{id, static_cast<uint32_t>(id % 7)});
+    Interiors b = a;
+    EXPECT_EQ(b.size(), 3);
+    EXPECT_EQ(b.innermost().id, 33u);
+    EXPECT_EQ(b.innermost().material, 33u % 7);
+    EXPECT_TRUE(b.contains(11) && b.contains(22) && !b.contains(44));
+    b.push(Interior{44, 1});
+    EXPECT_TRUE(b.contains(44));
+    EXPECT_FALSE(a.contains(44));
+    Interiors deeper;
+    for (uint64_t id = 100; id < 140; ++id) deeper.push(Interior{id, 2});  // 8 ignored
+    EXPECT_EQ(deeper.size(), Interiors::kCapacity);
+    deeper = a;
+    EXPECT_EQ(deeper.size(), 3);
+    EXPECT_FALSE(deeper.contains(100));
+    EXPECT_TRUE(deeper.remove(33));
+    EXPECT_EQ(deeper.innermost().id, 22u);
+    EXPECT_EQ(a.innermost().id, 33u);
+    deeper.push(Interior{55, 4});
+    EXPECT_EQ(deeper.innermost().material, 4u);
+    EXPECT_FALSE(deeper.contains(131));  // a slot of the old stack, not copied over
+    Interiors empty;
+    deeper = empty;
+    EXPECT_TRUE(deeper.empty());
+    EXPECT_FALSE(deeper.contains(11));
+}
+
 TEST(Transparency, TotalInternalReflectionBeyondTheCriticalAngle) {
     const Vec3 n{0, 0, 1};
     const double ior = 1.5;  // leaving glass into air

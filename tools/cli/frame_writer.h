@@ -1,10 +1,11 @@
 // The PNG files of a frame sequence (`pcsg render --frames N`), each encoded on a thread of
-// its own while the next frame renders: libpng's filters and zlib take one thread some
-// 120 M instructions a 640x480 frame (30 ms), during which the render's other threads
-// used to wait. The pixels are turned into 8-bit sRGB values (png_writer.h's srgbBytes, in
-// parallel) before the hand-over, so what waits is 0.9 MB of bytes, not the 3.7 MB of
-// floats; and one file at a time is written: the next is handed over only once the last
-// is done. The files are byte for byte those writePng() writes.
+// its own while the next frame renders: libpng and zlib took one thread some 120 M
+// instructions a 640x480 frame (30 ms; 20 to 40 M since the rows are written unfiltered,
+// png_writer.cpp), during which the render's other threads used to wait. The pixels are
+// turned into 8-bit sRGB values (png_writer.h's srgbBytes, in parallel) before the
+// hand-over, so what waits is 0.9 MB of bytes, not the 3.7 MB of floats; and one file at a
+// time is written: the next is handed over only once the last is done. The files are byte
+// for byte those writePng() writes.
 #pragma once
 
 #include <cstdint>

@@ -5,8 +5,13 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -56,6 +61,26 @@ TEST(PngWriter, TheTableGivesTheFormulasBytes) {
     EXPECT_EQ(wrong, 0u);
 }
 
+// Runs of equal values (a flat sky) take the byte of the value three before them: still
+// the formula's bytes, for runs, alternations, values equal but for their bits (0 and -0,
+// NaNs) and spans that start anywhere.
+TEST(PngWriter, RepeatedValuesGiveTheFormulasBytes) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<float> values;
+    for (float v : {0.3f, 0.3f, 0.3f, 0.3f, 0.7f, 0.3f, 0.3f,  0.0f,  -0.0f, 0.0f,  0.5f,  -0.0f,
+                    nan,  0.2f, 0.9f, nan,  2.0f, 0.9f, 0.01f, 0.01f, 0.01f, 0.02f, 0.01f, 0.01f})
+        values.push_back(v);
+    for (int i = 0; i < 300; ++i) values.push_back(i % 7 < 4 ? 0.25f : 0.001f * i);
+    auto formula = [](float v) { return static_cast<uint8_t>(std::lround(srgbEncode(v) * 255.0)); };
+    for (size_t start : {size_t{0}, size_t{1}, size_t{2}, size_t{5}}) {
+        const std::span<const float> part = std::span(values).subspan(start);
+        std::vector<uint8_t> bytes(part.size(), 77);
+        srgbBytesInto(part, bytes);
+        for (size_t i = 0; i < part.size(); ++i)
+            ASSERT_EQ(bytes[i], formula(part[i])) << "value " << start + i;
+    }
+}
+
 TEST(PngWriter, OpenImageIOReadsBackWhatWasWritten) {
     TempDir dir;
     const std::string out = dir.file("img.png");
@@ -67,6 +92,54 @@ TEST(PngWriter, OpenImageIOReadsBackWhatWasWritten) {
     EXPECT_EQ(spec.nchannels, 3);
     EXPECT_EQ(px, k8Bit);
     EXPECT_EQ(filesIn(dir.path()), std::vector<std::string>{"img.png"});
+}
+
+// The bytes of a PNG file's image data: its IDAT chunks joined and inflated.
+std::vector<uint8_t> inflatedImageData(const std::string& path, size_t expected) {
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<uint8_t> file{std::istreambuf_iterator<char>(in), {}};
+    std::vector<uint8_t> deflated;
+    for (size_t at = 8; at + 12 <= file.size();) {  // after the signature: length, type, data, CRC
+        const size_t length = (size_t{file[at]} << 24) | (size_t{file[at + 1]} << 16) |
+                              (size_t{file[at + 2]} << 8) | file[at + 3];
+        if (std::string(file.begin() + at + 4, file.begin() + at + 8) == "IDAT")
+            deflated.insert(deflated.end(), file.begin() + at + 8, file.begin() + at + 8 + length);
+        at += 12 + length;
+    }
+    std::vector<uint8_t> out(expected + 1);
+    uLongf size = out.size();
+    EXPECT_EQ(uncompress(out.data(), &size, deflated.data(), deflated.size()), Z_OK);
+    out.resize(size);
+    return out;
+}
+
+// The rows are written unfiltered (filter type 0 before each row: libpng's adaptive choice
+// among all five filters cost a frame of the growing tree three times the rest of the
+// encoding, docs/benchmarks.md), and the file still holds exactly the pixels: a gradient
+// with noise, on which the adaptive choice would pick Sub, Up or Paeth.
+TEST(PngWriter, RowsAreUnfilteredAndHoldThePixels) {
+    const int w = 61, h = 37;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> noise(0.0f, 0.02f);
+    std::vector<float> rgb;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            rgb.insert(rgb.end(), {x / float(w) + noise(rng), y / float(h), 0.5f + noise(rng)});
+    TempDir dir;
+    const std::string out = dir.file("img.png");
+    writePng(out, w, h, rgb);
+    OIIO::ImageSpec spec;
+    EXPECT_EQ(readBack<uint8_t>(out, OIIO::TypeDesc::UINT8, spec), srgbBytes(rgb));
+    const size_t row = static_cast<size_t>(w) * 3 + 1;
+    const std::vector<uint8_t> data = inflatedImageData(out, row * h);
+    ASSERT_EQ(data.size(), row * h);
+    const std::vector<uint8_t> bytes = srgbBytes(rgb);
+    for (int y = 0; y < h; ++y) {
+        EXPECT_EQ(data[y * row], 0) << "row " << y << " is filtered";
+        EXPECT_TRUE(std::equal(bytes.begin() + y * (row - 1), bytes.begin() + (y + 1) * (row - 1),
+                               data.begin() + y * row + 1))
+            << "row " << y;
+    }
 }
 
 TEST(PngWriter, AFailureNamesTheFileAndLeavesNothing) {
