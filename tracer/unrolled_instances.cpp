@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <unordered_map>
 
 #include "bounds.h"
 #include "eval.h"
+#include "flat_index.h"
 #include "outward_float.h"
 #include "traversal.h"
 
@@ -187,10 +187,9 @@ class Unroller {
         std::memcpy(words, &m, sizeof words);
         uint64_t h = 0x9e3779b97f4a7c15ULL;
         for (uint64_t w : words) h = (h ^ w) * 0xff51afd7ed558ccdULL;
-        const auto [it, inserted] =
-            matrixIndex_.try_emplace(h, static_cast<uint32_t>(out_.matrices_.size()));
-        if (!inserted && std::memcmp(&out_.matrices_[it->second], &m, sizeof m) == 0)
-            return it->second;
+        const auto [at, inserted] =
+            matrixIndex_.tryEmplace(h, static_cast<uint32_t>(out_.matrices_.size()));
+        if (!inserted && std::memcmp(&out_.matrices_[at], &m, sizeof m) == 0) return at;
         out_.matrices_.push_back(m);
         return static_cast<uint32_t>(out_.matrices_.size() - 1);
     }
@@ -241,10 +240,10 @@ class Unroller {
     // The link that applies out_.matrices_[matrix] after the chain `parent`.
     uint32_t linkTo(uint32_t parent, uint32_t matrix) {
         const uint64_t key = (static_cast<uint64_t>(parent) << 32) | matrix;
-        const auto [it, added] =
-            linkIndex_.try_emplace(key, static_cast<uint32_t>(out_.links_.size()));
+        const auto [at, added] =
+            linkIndex_.tryEmplace(key, static_cast<uint32_t>(out_.links_.size()));
         if (added) out_.links_.push_back({parent, matrix});
-        return it->second;
+        return at;
     }
 
     // Builds the BVHs of the unions that first hits reach through n: one operand per leaf.
@@ -386,12 +385,12 @@ class Unroller {
     }
     std::vector<std::unique_ptr<double[]>> frames_;
     size_t framesUsed_ = 0;
-    std::vector<uint32_t> pending_;                       // matrices (indices in out_.matrices_)
-    std::unordered_map<uint64_t, uint32_t> matrixIndex_;  // by the bits' hash
+    std::vector<uint32_t> pending_;  // matrices (indices in out_.matrices_)
+    FlatIndex matrixIndex_;          // by the bits' hash
     std::vector<uint32_t> choices_;
-    std::vector<uint32_t> kids_;                        // operands of the operators being built
-    std::unordered_map<uint64_t, uint32_t> linkIndex_;  // linkTo()'s links by (parent, matrix)
-    std::vector<Binary> binary_;                        // the hierarchy being built
+    std::vector<uint32_t> kids_;  // operands of the operators being built
+    FlatIndex linkIndex_;         // linkTo()'s links by (parent, matrix)
+    std::vector<Binary> binary_;  // the hierarchy being built
 };
 
 // ---------------------------------------------------------------------------------------
