@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <limits>
 
 #include "bounds.h"
@@ -33,6 +34,21 @@ struct TooLarge {};
 // (semantics.h: the same selections, C-nodes and T-node inverses, fused along constant
 // chains), in the same order, and keeps what it meets in flat arrays.
 
+// The arrays of the expansions one thread builds. An expansion grows these (they keep
+// their capacity from one expansion to the next) and copies them out at their final
+// sizes: its own arrays, grown by doubling from nothing and shrunk to fit, had been a few
+// dozen allocations and copies per expansion, and each freed array of 64 KB or more a
+// malloc_consolidate.
+struct BuildArrays {
+    std::vector<UnrolledInstance::Node> nodes;
+    std::vector<uint32_t> children, matrixRefs, choices;
+    std::vector<Affine> matrices;
+    std::vector<double> args;
+    std::vector<UnrolledInstance::BvhNode> bvh;
+    std::vector<UnrolledInstance::Link> links;
+    bool lent = false;
+};
+
 class Unroller {
   public:
     Unroller(const TraceScene& scene, UnrolledInstance& out, uint64_t maxVisits)
@@ -50,19 +66,64 @@ class Unroller {
         choices_.push_back(kRuleBit | rule);
         base_ = depth;
         const PathState s{root, pathRule(path, rule), depth, UnrolledInstance::kInherit};
+        const Lent lent(out_);
         out_.root_ = build(g_.child(select, rule), s, 0, Affine::identity());
         if (out_.root_ != kNone) hierarchy(out_.root_);
-        out_.nodes_.shrink_to_fit();
-        out_.bvh_.shrink_to_fit();
-        out_.children_.shrink_to_fit();
-        out_.matrices_.shrink_to_fit();
-        out_.matrixRefs_.shrink_to_fit();
-        out_.args_.shrink_to_fit();
-        out_.choices_.shrink_to_fit();
-        out_.links_.shrink_to_fit();
     }
 
   private:
+    // Applies f(the thread's array, the expansion's) to each array of an expansion.
+    template <class F>
+    static void eachArray(BuildArrays& b, UnrolledInstance& x, F&& f) {
+        f(b.nodes, x.nodes_);
+        f(b.children, x.children_);
+        f(b.matrices, x.matrices_);
+        f(b.matrixRefs, x.matrixRefs_);
+        f(b.args, x.args_);
+        f(b.choices, x.choices_);
+        f(b.bvh, x.bvh_);
+        f(b.links, x.links_);
+    }
+
+    // The thread's BuildArrays lent to the expansion being built (when no other on this
+    // thread has them), and taken back when it is done: the expansion's arrays are copied
+    // out at their final sizes, or, should the build throw, given up.
+    class Lent {
+      public:
+        explicit Lent(UnrolledInstance& x) : x_(x), b_(arrays()), mine_(!b_.lent) {
+            if (!mine_) return;
+            b_.lent = true;
+            eachArray(b_, x_, [](auto& b, auto& x) {
+                b.clear();
+                x.swap(b);
+            });
+        }
+        ~Lent() {
+            if (!mine_) {
+                eachArray(b_, x_, [](auto&, auto& x) { x.shrink_to_fit(); });
+                return;
+            }
+            const bool done = std::uncaught_exceptions() == 0;
+            eachArray(b_, x_, [done](auto& b, auto& x) {
+                b.swap(x);
+                if (done) x.assign(b.begin(), b.end());
+                b.clear();
+            });
+            b_.lent = false;
+        }
+        Lent(const Lent&) = delete;
+        Lent& operator=(const Lent&) = delete;
+
+      private:
+        static BuildArrays& arrays() {
+            thread_local BuildArrays a;
+            return a;
+        }
+        UnrolledInstance& x_;
+        BuildArrays& b_;
+        const bool mine_;
+    };
+
     using Node = UnrolledInstance::Node;
     using Kind = UnrolledInstance::Kind;
     using BvhNode = UnrolledInstance::BvhNode;
