@@ -112,6 +112,20 @@ class Expander {
     }
 };
 
+// The instance a scene's axiom C-node hands to the S-node below it ({n = 4} S): that
+// S-node and the frame, for tests that expand or box it with other parameter values.
+struct AxiomInstance {
+    NodeId select = kNone;
+    std::vector<double> frame;
+};
+inline AxiomInstance axiomInstance(const Graph& g) {
+    AxiomInstance a{g.child(g.axiom), std::vector<double>(g.slotCount())};
+    std::vector<double> root(g.slotCount());
+    initFrame(g, root.data());
+    applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, a.frame.data());
+    return a;
+}
+
 // Expand wherever an instance is met a second time, from the first instance on.
 inline InstanceBoxOptions eagerExpansion() {
     InstanceBoxOptions o;

@@ -188,10 +188,7 @@ TEST(UnrollCache, AnInstanceLargerThanItsShareIsRefusedAndTheLevelBelowIsExpande
     // The budget's share holds the instance at depth 2 (order 3), twice over, not the one
     // at depth 1 (four times as large): the margin leaves room for the cache's estimate of
     // a level's size before its first expansion.
-    std::vector<double> root(g.slotCount()), frame(g.slotCount());
-    initFrame(g, root.data());
-    applyCalc(g, g.axiom, EvalState{root.data(), kRootPath}, frame.data());
-    const NodeId select = g.child(g.axiom);
+    auto [select, frame] = testing::axiomInstance(g);
     const auto order = std::find(frame.begin(), frame.end(), 4.0);
     ASSERT_NE(order, frame.end());
     auto bytesAt = [&](double c) {

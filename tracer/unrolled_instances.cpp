@@ -4,11 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <limits>
-#include <unordered_map>
 
 #include "bounds.h"
 #include "eval.h"
+#include "flat_index.h"
 #include "outward_float.h"
 #include "traversal.h"
 
@@ -33,6 +34,21 @@ struct TooLarge {};
 // (semantics.h: the same selections, C-nodes and T-node inverses, fused along constant
 // chains), in the same order, and keeps what it meets in flat arrays.
 
+// The arrays of the expansions one thread builds. An expansion grows these (they keep
+// their capacity from one expansion to the next) and copies them out at their final
+// sizes: its own arrays, grown by doubling from nothing and shrunk to fit, had been a few
+// dozen allocations and copies per expansion, and each freed array of 64 KB or more a
+// malloc_consolidate.
+struct BuildArrays {
+    std::vector<UnrolledInstance::Node> nodes;
+    std::vector<uint32_t> children, matrixRefs, choices;
+    std::vector<Affine> matrices;
+    std::vector<double> args;
+    std::vector<UnrolledInstance::BvhNode> bvh;
+    std::vector<UnrolledInstance::Link> links;
+    bool lent = false;
+};
+
 class Unroller {
   public:
     Unroller(const TraceScene& scene, UnrolledInstance& out, uint64_t maxVisits)
@@ -50,19 +66,64 @@ class Unroller {
         choices_.push_back(kRuleBit | rule);
         base_ = depth;
         const PathState s{root, pathRule(path, rule), depth, UnrolledInstance::kInherit};
+        const Lent lent(out_);
         out_.root_ = build(g_.child(select, rule), s, 0, Affine::identity());
         if (out_.root_ != kNone) hierarchy(out_.root_);
-        out_.nodes_.shrink_to_fit();
-        out_.bvh_.shrink_to_fit();
-        out_.children_.shrink_to_fit();
-        out_.matrices_.shrink_to_fit();
-        out_.matrixRefs_.shrink_to_fit();
-        out_.args_.shrink_to_fit();
-        out_.choices_.shrink_to_fit();
-        out_.links_.shrink_to_fit();
     }
 
   private:
+    // Applies f(the thread's array, the expansion's) to each array of an expansion.
+    template <class F>
+    static void eachArray(BuildArrays& b, UnrolledInstance& x, F&& f) {
+        f(b.nodes, x.nodes_);
+        f(b.children, x.children_);
+        f(b.matrices, x.matrices_);
+        f(b.matrixRefs, x.matrixRefs_);
+        f(b.args, x.args_);
+        f(b.choices, x.choices_);
+        f(b.bvh, x.bvh_);
+        f(b.links, x.links_);
+    }
+
+    // The thread's BuildArrays lent to the expansion being built (when no other on this
+    // thread has them), and taken back when it is done: the expansion's arrays are copied
+    // out at their final sizes, or, should the build throw, given up.
+    class Lent {
+      public:
+        explicit Lent(UnrolledInstance& x) : x_(x), b_(arrays()), mine_(!b_.lent) {
+            if (!mine_) return;
+            b_.lent = true;
+            eachArray(b_, x_, [](auto& b, auto& x) {
+                b.clear();
+                x.swap(b);
+            });
+        }
+        ~Lent() {
+            if (!mine_) {
+                eachArray(b_, x_, [](auto&, auto& x) { x.shrink_to_fit(); });
+                return;
+            }
+            const bool done = std::uncaught_exceptions() == 0;
+            eachArray(b_, x_, [done](auto& b, auto& x) {
+                b.swap(x);
+                if (done) x.assign(b.begin(), b.end());
+                b.clear();
+            });
+            b_.lent = false;
+        }
+        Lent(const Lent&) = delete;
+        Lent& operator=(const Lent&) = delete;
+
+      private:
+        static BuildArrays& arrays() {
+            thread_local BuildArrays a;
+            return a;
+        }
+        UnrolledInstance& x_;
+        BuildArrays& b_;
+        const bool mine_;
+    };
+
     using Node = UnrolledInstance::Node;
     using Kind = UnrolledInstance::Kind;
     using BvhNode = UnrolledInstance::BvhNode;
@@ -187,10 +248,9 @@ class Unroller {
         std::memcpy(words, &m, sizeof words);
         uint64_t h = 0x9e3779b97f4a7c15ULL;
         for (uint64_t w : words) h = (h ^ w) * 0xff51afd7ed558ccdULL;
-        const auto [it, inserted] =
-            matrixIndex_.try_emplace(h, static_cast<uint32_t>(out_.matrices_.size()));
-        if (!inserted && std::memcmp(&out_.matrices_[it->second], &m, sizeof m) == 0)
-            return it->second;
+        const auto [at, inserted] =
+            matrixIndex_.tryEmplace(h, static_cast<uint32_t>(out_.matrices_.size()));
+        if (!inserted && std::memcmp(&out_.matrices_[at], &m, sizeof m) == 0) return at;
         out_.matrices_.push_back(m);
         return static_cast<uint32_t>(out_.matrices_.size() - 1);
     }
@@ -241,10 +301,10 @@ class Unroller {
     // The link that applies out_.matrices_[matrix] after the chain `parent`.
     uint32_t linkTo(uint32_t parent, uint32_t matrix) {
         const uint64_t key = (static_cast<uint64_t>(parent) << 32) | matrix;
-        const auto [it, added] =
-            linkIndex_.try_emplace(key, static_cast<uint32_t>(out_.links_.size()));
+        const auto [at, added] =
+            linkIndex_.tryEmplace(key, static_cast<uint32_t>(out_.links_.size()));
         if (added) out_.links_.push_back({parent, matrix});
-        return it->second;
+        return at;
     }
 
     // Builds the BVHs of the unions that first hits reach through n: one operand per leaf.
@@ -386,12 +446,12 @@ class Unroller {
     }
     std::vector<std::unique_ptr<double[]>> frames_;
     size_t framesUsed_ = 0;
-    std::vector<uint32_t> pending_;                       // matrices (indices in out_.matrices_)
-    std::unordered_map<uint64_t, uint32_t> matrixIndex_;  // by the bits' hash
+    std::vector<uint32_t> pending_;  // matrices (indices in out_.matrices_)
+    FlatIndex matrixIndex_;          // by the bits' hash
     std::vector<uint32_t> choices_;
-    std::vector<uint32_t> kids_;                        // operands of the operators being built
-    std::unordered_map<uint64_t, uint32_t> linkIndex_;  // linkTo()'s links by (parent, matrix)
-    std::vector<Binary> binary_;                        // the hierarchy being built
+    std::vector<uint32_t> kids_;  // operands of the operators being built
+    FlatIndex linkIndex_;         // linkTo()'s links by (parent, matrix)
+    std::vector<Binary> binary_;  // the hierarchy being built
 };
 
 // ---------------------------------------------------------------------------------------

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <thread>
 
 #include "bounds.h"
 #include "outward_float.h"
@@ -244,6 +246,48 @@ S if(n > 0, 2, 1)
             }
         }
     EXPECT_TRUE(thrown);
+}
+
+// A thread builds its expansions in arrays it keeps from one to the next (BuildArrays):
+// each expansion still gets arrays of its own, at their final sizes, holding only what it
+// holds: the same bytes and hits as the first expansion of a fresh thread, after a larger
+// one, and after one given up half-built (too many visits).
+TEST(ExpandedInstances, AnExpansionsArraysAreItsOwnWhateverTheThreadBuiltBefore) {
+    auto c = compile(testing::kFlower);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene scene(g, computeBounds(g), true, eagerExpansion());
+    auto [select, frame] = testing::axiomInstance(g);
+    const auto petals = std::find(frame.begin(), frame.end(), 21.0);
+    ASSERT_NE(petals, frame.end());
+    auto expand = [&](double p, uint64_t maxVisits = 1u << 20) {
+        *petals = p;
+        return UnrolledInstance::expand(scene, select, 1, frame.data(), kRootPath, maxVisits);
+    };
+    auto hitOf = [](const UnrolledInstance& x) {
+        UnrolledInstance::Scratch s;
+        Hit h;
+        double tmax = 1e9;
+        x.first(LocalRay{{0.1, -5, 0.05}, Vec3{0, 1, 0}}, 1e-6, tmax, h, {kRootPath, 0, 0}, false,
+                s);
+        return std::make_pair(h.t, tmax);
+    };
+    std::unique_ptr<UnrolledInstance> fresh;
+    std::thread([&] { fresh = expand(5); }).join();
+    ASSERT_TRUE(fresh);
+    const auto large = expand(21);
+    ASSERT_TRUE(large);
+    ASSERT_GT(large->bytes(), fresh->bytes());
+    const auto after = expand(5);
+    ASSERT_TRUE(after);
+    EXPECT_EQ(after->bytes(), fresh->bytes());
+    EXPECT_EQ(after->bvhNodes(), fresh->bvhNodes());
+    EXPECT_EQ(hitOf(*after), hitOf(*fresh));
+    EXPECT_FALSE(expand(21, 10));  // given up half-built
+    const auto again = expand(5);
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->bytes(), fresh->bytes());
+    EXPECT_EQ(hitOf(*again), hitOf(*fresh));
 }
 
 }  // namespace
