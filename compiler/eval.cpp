@@ -455,12 +455,39 @@ void primitiveArgs(const Graph& g, NodeId n, EvalState s, double* out) {
     }
 }
 
-double sinDegrees(double a) {
+namespace {
+
+double sinDegreesComputed(double a) {
     const double r = std::fmod(a, 360.0);
     if (r == 0 || r == 180 || r == -180) return 0;
     if (r == 90 || r == -270) return 1;
     if (r == -90 || r == 270) return -1;
     return std::sin(a * kDegToRad);
+}
+
+// The sines computed last, per thread, direct-mapped by the bits of the angle: a C-node's
+// angles repeat (the terrains' taper takes the sine of each corner's coordinates, 513
+// values at order 9, for every triangle at that corner, in the instance boxes' prefill, the
+// expansions and the rays' walk), and std::fmod and std::sin cost some 150 instructions.
+// A value recalled is the one computed for the same bits. All zero at first: the sine of
+// +0 degrees is +0.
+struct SinMemo {
+    static constexpr int kLog2 = 10;
+    struct Slot {
+        uint64_t angle = 0;
+        double sine = 0;
+    };
+    Slot slot[1u << kLog2];
+};
+
+}  // namespace
+
+double sinDegrees(double a) {
+    thread_local SinMemo memo;
+    const uint64_t bits = std::bit_cast<uint64_t>(a);
+    SinMemo::Slot& s = memo.slot[(bits * 0x9e3779b97f4a7c15ull) >> (64 - SinMemo::kLog2)];
+    if (s.angle != bits) s = SinMemo::Slot{bits, sinDegreesComputed(a)};
+    return s.sine;
 }
 
 double cosDegrees(double a) {

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <set>
 
@@ -54,6 +56,35 @@ TEST(Eval, TrigonometryIsInDegreesAndExactAtRightAngles) {
     EXPECT_EQ(call(Func::Max, {3, -1, 2}), 3.0);
     EXPECT_EQ(call(Func::Clamp, {5, 0, 2}), 2.0);
     EXPECT_TRUE(std::isnan(call(Func::Sqrt, {-1})));
+}
+
+// sinDegrees recalls the sines it computed last (per thread, by the angle's bits): every
+// value must be the one computed for that angle, also after other angles took its slot.
+TEST(Eval, RecalledSinesAreTheComputedOnesBitForBit) {
+    auto computed = [](double a) {
+        const double r = std::fmod(a, 360.0);
+        if (r == 0 || r == 180 || r == -180) return 0.0;
+        if (r == 90 || r == -270) return 1.0;
+        if (r == -90 || r == 270) return -1.0;
+        return std::sin(a * (3.14159265358979323846 / 180.0));
+    };
+    // A terrain's corners (180 k / 512), more angles than the memo has slots, -0, and
+    // angles that differ in their last bit.
+    std::vector<double> angles;
+    for (int k = 0; k <= 4096; ++k) angles.push_back(180.0 * (k / 512.0));
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1000.0, 1000.0);
+    for (int k = 0; k < 3000; ++k) angles.push_back(u(rng));
+    for (double a : {-0.0, 0.0, 90.0, std::nextafter(90.0, 100.0), -270.0, 1e300})
+        angles.push_back(a);
+    for (int round = 0; round < 3; ++round) {
+        for (double a : angles) {
+            const double got = sinDegrees(a), want = computed(a);
+            ASSERT_EQ(std::memcmp(&got, &want, sizeof got), 0) << "angle " << a;
+            ASSERT_EQ(cosDegrees(a), computed(a + 90.0)) << "angle " << a;
+        }
+        std::shuffle(angles.begin(), angles.end(), rng);
+    }
 }
 
 TEST(Eval, JumpsEvaluateOnlyTheBranchTaken) {
