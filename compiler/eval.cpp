@@ -4,9 +4,11 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <tuple>
 
 #include "eval_core.h"
 
@@ -116,11 +118,11 @@ double callFunc(Func f, const double* a, uint32_t n, uint64_t seed) {
         case Func::Exp:
             return std::exp(a[0]);
         case Func::Ln:
-            return std::log(a[0]);
+            return lnRecalled(a[0]);
         case Func::Log10:
             return std::log10(a[0]);
         case Func::Pow:
-            return std::pow(a[0], a[1]);
+            return powRecalled(a[0], a[1]);
         case Func::Abs:
             return std::fabs(a[0]);
         case Func::Floor:
@@ -224,7 +226,7 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
                 PCSG_BINARY(Mul, a * b)
                 PCSG_BINARY(Div, a / b)
                 PCSG_BINARY(Mod, std::fmod(a, b))
-                PCSG_BINARY(Pow, std::pow(a, b))
+                PCSG_BINARY(Pow, powRecalled(a, b))
                 PCSG_BINARY(Lt, a < b ? 1.0 : 0.0)
                 PCSG_BINARY(Le, a <= b ? 1.0 : 0.0)
                 PCSG_BINARY(Gt, a > b ? 1.0 : 0.0)
@@ -455,12 +457,69 @@ void primitiveArgs(const Graph& g, NodeId n, EvalState s, double* out) {
     }
 }
 
-double sinDegrees(double a) {
+namespace {
+
+double sinDegreesComputed(double a) {
     const double r = std::fmod(a, 360.0);
     if (r == 0 || r == 180 || r == -180) return 0;
     if (r == 90 || r == -270) return 1;
     if (r == -90 || r == 270) return -1;
     return std::sin(a * kDegToRad);
+}
+
+// The values of a function computed last, per thread, direct-mapped by the bits of its
+// arguments: a C-node's values repeat (the terrains' taper takes the sine of each corner's
+// coordinates, 513 values at order 9, and a power of each corner, for every triangle at that
+// corner; their displacements a logarithm of each edge's random number, for both triangles
+// at the edge; in the instance boxes' prefill, the expansions and the rays' walk), and
+// std::fmod with std::sin, std::pow or std::log cost some 100 to 150 instructions. A value
+// recalled is the one computed for the same bits. At first every slot holds the value at
+// +0 arguments.
+template <size_t N, class F>
+class Recall {
+  public:
+    explicit Recall(F f) : f_(f) {
+        const double atZero = std::apply(f_, std::array<double, N>{});
+        for (Slot& s : slot_) s = Slot{{}, atZero};
+    }
+    double operator()(const std::array<double, N>& args) {
+        std::array<uint64_t, N> bits;
+        uint64_t h = 0;
+        for (size_t i = 0; i < N; ++i) {
+            bits[i] = std::bit_cast<uint64_t>(args[i]);
+            h = (h ^ bits[i]) * 0x9e3779b97f4a7c15ull;
+        }
+        Slot& s = slot_[h >> (64 - kLog2)];
+        if (s.bits != bits) s = Slot{bits, std::apply(f_, args)};
+        return s.value;
+    }
+
+  private:
+    static constexpr int kLog2 = 10;
+    struct Slot {
+        std::array<uint64_t, N> bits;
+        double value;
+    };
+    F f_;
+    std::array<Slot, size_t{1} << kLog2> slot_;
+};
+
+}  // namespace
+
+double sinDegrees(double a) {
+    thread_local Recall<1, double (*)(double)> memo(sinDegreesComputed);
+    return memo({a});
+}
+
+double powRecalled(double a, double b) {
+    thread_local Recall<2, double (*)(double, double)> memo(
+        [](double x, double y) { return std::pow(x, y); });
+    return memo({a, b});
+}
+
+double lnRecalled(double a) {
+    thread_local Recall<1, double (*)(double)> memo([](double x) { return std::log(x); });
+    return memo({a});
 }
 
 double cosDegrees(double a) {

@@ -12,6 +12,12 @@
 
 namespace pcsg {
 
+// std::pow and std::log of the language's pow() and ln(), recalled per thread by the bits of
+// their arguments as sinDegrees() is (eval.cpp): the terrains repeat them at every triangle
+// that shares a corner or an edge. The same bits as std::pow and std::log.
+double powRecalled(double a, double b);
+double lnRecalled(double a);
+
 // SplitMix64's finaliser: a bijective 64-bit mixer.
 constexpr uint64_t mix64(uint64_t z) {
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;

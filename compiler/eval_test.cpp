@@ -3,10 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <set>
 
+#include "eval_core.h"
 #include "raw_code_test_util.h"
 
 namespace pcsg {
@@ -54,6 +57,44 @@ TEST(Eval, TrigonometryIsInDegreesAndExactAtRightAngles) {
     EXPECT_EQ(call(Func::Max, {3, -1, 2}), 3.0);
     EXPECT_EQ(call(Func::Clamp, {5, 0, 2}), 2.0);
     EXPECT_TRUE(std::isnan(call(Func::Sqrt, {-1})));
+}
+
+// sinDegrees, powRecalled and lnRecalled recall the values they computed last (per thread,
+// by the arguments' bits): every value must be the one computed for those arguments, also
+// after other arguments took its slot.
+TEST(Eval, RecalledValuesAreTheComputedOnesBitForBit) {
+    auto computed = [](double a) {
+        const double r = std::fmod(a, 360.0);
+        if (r == 0 || r == 180 || r == -180) return 0.0;
+        if (r == 90 || r == -270) return 1.0;
+        if (r == -90 || r == 270) return -1.0;
+        return std::sin(a * (3.14159265358979323846 / 180.0));
+    };
+    auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    // A terrain's corners (180 k / 512), more values than the memo has slots, -0, and
+    // values that differ in their last bit.
+    std::vector<double> angles;
+    for (int k = 0; k <= 4096; ++k) angles.push_back(180.0 * (k / 512.0));
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1000.0, 1000.0);
+    for (int k = 0; k < 3000; ++k) angles.push_back(u(rng));
+    for (double a : {-0.0, 0.0, 90.0, std::nextafter(90.0, 100.0), -270.0, 1e300})
+        angles.push_back(a);
+    for (int round = 0; round < 3; ++round) {
+        for (double a : angles) {
+            ASSERT_TRUE(same(sinDegrees(a), computed(a))) << "angle " << a;
+            ASSERT_TRUE(same(cosDegrees(a), computed(a + 90.0))) << "angle " << a;
+            const double x = std::fabs(a) / 1000, y = a / 997;
+            ASSERT_TRUE(same(powRecalled(x, 0.3), std::pow(x, 0.3))) << "pow " << x;
+            ASSERT_TRUE(same(powRecalled(x, y), std::pow(x, y))) << "pow " << x << ", " << y;
+            ASSERT_TRUE(same(powRecalled(y, 0.3), std::pow(y, 0.3))) << "pow " << y;  // NaN < 0
+            ASSERT_TRUE(same(lnRecalled(x), std::log(x))) << "ln " << x;
+            ASSERT_TRUE(same(lnRecalled(y), std::log(y))) << "ln " << y;
+        }
+        std::shuffle(angles.begin(), angles.end(), rng);
+    }
+    EXPECT_TRUE(same(powRecalled(0.0, 0.0), 1.0));  // the value every slot starts with
+    EXPECT_TRUE(same(lnRecalled(0.0), -HUGE_VAL));
 }
 
 TEST(Eval, JumpsEvaluateOnlyTheBranchTaken) {

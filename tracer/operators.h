@@ -132,13 +132,34 @@ inline bool clipToBox(const Box& b, const LocalRay& r, double& t0, double& t1) {
     return true;
 }
 
+// Whether operand i is in a union's mask of leading operands (firstOfUnion).
+inline bool leadsUnion(uint32_t lead, uint32_t i) {
+    return i < 32 && ((lead >> i) & 1u);
+}
+
 // The first hit among a union's operands. `entry(i, t0)` sets t0 to where the ray enters
 // operand i's box within [tmin, tmax] and returns false when it misses the box;
 // `first(i, tmax, hit)` looks for a nearer surface in operand i. `order` is scratch space
 // (used as a stack, so the walk may recurse).
+// `lead` (bit i: operand i, i < 32) names operands looked at first, in operand order,
+// whatever their boxes' entry: cheap ones (TraceScene::unionLeads: a primitive below
+// constant steps) whose hit then narrows the window of the others, as a sea's plane does
+// for the terrain under it, whose box the ray enters first. The union's hit is the nearest
+// (t, instance path) of all its operands whatever the order they are looked at in (nearer()),
+// and a box only culls what lies beyond the nearest hit, so the hit is the same.
 template <class Entry, class First>
 bool firstOfUnion(uint32_t count, double tmin, double& tmax, Hit& hit, bool anyHit,
-                  std::vector<std::pair<double, uint32_t>>& order, Entry entry, First first) {
+                  std::vector<std::pair<double, uint32_t>>& order, Entry entry, First first,
+                  uint32_t lead = 0) {
+    bool found = false;
+    for (uint32_t i = 0; lead != 0 && i < count && i < 32; ++i) {
+        double t0 = tmin;
+        if (!leadsUnion(lead, i) || !entry(i, t0) || t0 > tmax) continue;
+        if (first(i, tmax, hit)) {
+            found = true;
+            if (anyHit) return true;
+        }
+    }
     // Few operands (a BVH node's two halves, most unions of a derivation): sorted by
     // insertion on the stack, in the same order as std::sort gives below (by entry, then
     // by operand: the pairs are distinct, so the sorted order is unique).
@@ -151,12 +172,11 @@ bool firstOfUnion(uint32_t count, double tmin, double& tmax, Hit& hit, bool anyH
         uint32_t m = 0;
         for (uint32_t i = 0; i < count; ++i) {
             double t0 = tmin;
-            if (!entry(i, t0)) continue;
+            if (leadsUnion(lead, i) || !entry(i, t0)) continue;
             uint32_t k = m++;
             for (; k > 0 && few[k - 1].t0 > t0; --k) few[k] = few[k - 1];
             few[k] = {t0, i};
         }
-        bool found = false;
         for (uint32_t k = 0; k < m; ++k) {
             if (few[k].t0 > tmax) break;  // (at tmax exactly it may still win a tie)
             if (first(few[k].i, tmax, hit)) {
@@ -169,11 +189,10 @@ bool firstOfUnion(uint32_t count, double tmin, double& tmax, Hit& hit, bool anyH
     const size_t base = order.size();
     for (uint32_t i = 0; i < count; ++i) {
         double t0 = tmin;
-        if (entry(i, t0)) order.emplace_back(t0, i);
+        if (!leadsUnion(lead, i) && entry(i, t0)) order.emplace_back(t0, i);
     }
     const size_t end = order.size();
     if (end - base > 1) std::sort(order.begin() + base, order.begin() + end);
-    bool found = false;
     for (size_t k = base; k < end; ++k) {
         const auto [t0, i] = order[k];
         if (t0 > tmax) break;  // (at tmax exactly it may still win a tie)

@@ -63,6 +63,42 @@ void TraceScene::markPaintFrames() {
     if (any) paintFrames = std::move(marks);
 }
 
+namespace {
+
+// Whether the first hit below node m is one primitive's, found without evaluating anything:
+// a chain of paint nodes and constant T-nodes down to a primitive without arguments.
+bool cheapLeaf(const Graph& g, NodeId m) {
+    for (uint32_t k = 0; k < g.nodes.size(); ++k) {
+        const Node& node = g.nodes[m];
+        if (node.kind == NodeKind::Primitive)
+            return primitiveArgCount(g.primitives[node.payload].kind) == 0;
+        const bool step = node.kind == NodeKind::Paint ||
+                          (node.kind == NodeKind::Transform && g.transforms[node.payload].constant);
+        if (!step) return false;
+        m = g.child(m);
+    }
+    return false;
+}
+
+}  // namespace
+
+void TraceScene::markUnionLeads() {
+    unionLeads.assign(g_.nodes.size(), 0);
+    for (NodeId n = 0; n < g_.nodes.size(); ++n) {
+        const Node& node = g_.nodes[n];
+        if (node.kind != NodeKind::Operator || node.op() != CsgOp::Union) continue;
+        uint32_t lead = 0;
+        bool other = false;
+        for (uint32_t i = 0; i < node.childCount; ++i) {
+            if (i < 32 && cheapLeaf(g_, g_.child(n, i)))
+                lead |= 1u << i;
+            else
+                other = true;
+        }
+        if (other) unionLeads[n] = lead;
+    }
+}
+
 TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
                        const InstanceBoxOptions& instanceBoxOptions)
     : TraceScene(g, std::move(bounds), useInstanceBoxes, instanceBoxOptions, FixedSlots(g)) {}
@@ -76,6 +112,7 @@ TraceScene::TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
     const size_t n = g.nodes.size();
     if (bounds_.node.size() != n) bounds_.node.assign(n, Box::everything());
     markPaintFrames();
+    markUnionLeads();
     if (useInstanceBoxes && !g.modules.empty())
         instanceBoxes_ = std::make_unique<InstanceBoxes>(g, bounds_, instanceBoxOptions, fixed);
     // Longest chain of nested visits between two S-nodes (the graph without the edges into
@@ -370,7 +407,8 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 },
                 [&](uint32_t i, double& best, Hit& h) {
                     return first(g_.child(n, i), r, Semantics::operand(c, i), tmin, best, h);
-                });
+                },
+                scene_.unionLeads[n]);
         case NodeKind::Primitive:
             return firstOfPrimitive(n, r, c, tmin, tmax, hit);
     }

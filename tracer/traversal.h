@@ -123,6 +123,11 @@ class TraceScene {
     static constexpr uint8_t kPaintPoint = 1, kPaintMap = 2, kPaintInterior = 4;
     bool paintMaps = false;  // some material needs kPaintMap
     bool interiors = false;  // some material may let light through
+    // Per node: a union's operands that its first hit looks at before the others
+    // (firstOfUnion's `lead`, bit i: operand i): those that are one primitive without
+    // arguments below paint nodes and constant T-nodes, in a union that has other operands
+    // too (a plane beside a terrain). Their hit is cheap and narrows the window of the rest.
+    std::vector<uint32_t> unionLeads;
     bool paintMapOf(uint32_t material) const {
         return material < paintFrames.size() && (paintFrames[material] & kPaintMap);
     }
@@ -135,6 +140,7 @@ class TraceScene {
     TraceScene(const Graph& g, Bounds bounds, bool useInstanceBoxes,
                const InstanceBoxOptions& instanceBoxOptions, const FixedSlots& fixed);
     void markPaintFrames();
+    void markUnionLeads();
     const Graph& g_;
     Semantics sem_;
     StepMemoPlan memoPlan_;

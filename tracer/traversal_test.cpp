@@ -658,5 +658,86 @@ TEST(Traversal, UnionUnderIntersectionKeepsOperandsAfterACulledFirstOne) {
                   {-1, 0, 0}});
 }
 
+// A plane beside a recursive sub-graph that reaches above it: the union's leading operand
+// (TraceScene::unionLeads) is the plane, whose hit narrows the walk of the tetrahedra.
+const char* kSeaBeside = R"(
+material sea  { color <0, 0, 1> }
+material land { color <0, 1, 0> }
+paint(sea) move(0, 0, 0.1) plane ∪ {n = 4} paint(land) move(0.2, 0.1, -0.6) S
+S if(n > 0, 2, 1)
+1: S -> tetrahedron
+2: S -> {n = n-1} ( move(0.5, 0.5, 0.5) uscale(0.5) S ∪ move(-0.5, -0.5, 0.5) uscale(0.5) S ∪
+                    move(0.5, -0.5, -0.5) uscale(0.5) S ∪ move(-0.5, 0.5, -0.5) uscale(0.5) S )
+)";
+
+TEST(Traversal, UnionLeadsAreThePrimitivesBesideSubGraphs) {
+    auto c = compile(kSeaBeside);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const TraceScene scene(g, computeBounds(g));
+    ASSERT_EQ(scene.unionLeads.size(), g.nodes.size());
+    int unions = 0;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        const Node& node = g.nodes[n];
+        if (node.kind != NodeKind::Operator) {
+            EXPECT_EQ(scene.unionLeads[n], 0u);
+            continue;
+        }
+        ++unions;
+        if (node.childCount == 2)  // the axiom's: the plane (under paint and move) leads
+            EXPECT_EQ(scene.unionLeads[n], 1u);
+        else  // the rule's four S references: none
+            EXPECT_EQ(scene.unionLeads[n], 0u);
+    }
+    EXPECT_EQ(unions, 2);
+    // A union of primitives alone keeps its order by the boxes' entry: no leads. A T-node
+    // with a parameter is no leaf (its matrix is evaluated).
+    auto leadsOf = [](const char* text) {
+        auto only = compile(text);
+        EXPECT_TRUE(only->graph);
+        const TraceScene sc(*only->graph, computeBounds(*only->graph));
+        std::vector<uint32_t> leads;
+        for (NodeId n = 0; n < only->graph->nodes.size(); ++n)
+            if (only->graph->nodes[n].kind == NodeKind::Operator) leads.push_back(sc.unionLeads[n]);
+        return leads;
+    };
+    EXPECT_EQ(leadsOf("sphere ∪ move(2, 0, 0) cube"), std::vector<uint32_t>{0});
+    EXPECT_EQ(leadsOf("{a = rand()} (move(0, 0, a) sphere ∪ cube)"), std::vector<uint32_t>{2});
+}
+
+TEST(Traversal, UnionLeadsGiveTheSameHitsWithFewerVisits) {
+    auto c = compile(kSeaBeside);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene led(g, computeBounds(g)), plain(g, computeBounds(g));
+    plain.unionLeads.assign(g.nodes.size(), 0);
+    led.expansionBytes = plain.expansionBytes = 0;  // (visits of the graph walk alone)
+    Tracer a(led), b(plain);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int planeHits = 0, landHits = 0;
+    for (int k = 0; k < kRays; ++k) {
+        // (over the tetrahedra's square, x and y in [-0.8, 1.2] x [-0.9, 1.1] at the plane)
+        const Vec3 o{0.2 + u(rng) * 1.5, 0.1 + u(rng) * 1.5, 2 + u(rng)};
+        const Vec3 d =
+            normalize(Vec3{u(rng) * 0.3 - (o.x - 0.2) * 0.2, u(rng) * 0.3 - (o.y - 0.1) * 0.2, -1});
+        const std::string ray = vecText(o) + " towards " + vecText(d);
+        SurfaceHit ha, hb;
+        const bool fa = a.firstHit(o, d, 1e-4, 1e7, ha), fb = b.firstHit(o, d, 1e-4, 1e7, hb);
+        ASSERT_EQ(fa, fb) << ray;
+        EXPECT_EQ(a.anyHit(o, d, 1e-4, 1e7), b.anyHit(o, d, 1e-4, 1e7)) << ray;
+        if (!fa) continue;
+        EXPECT_EQ(ha.t, hb.t) << ray;
+        EXPECT_EQ(ha.normal, hb.normal) << ray;
+        EXPECT_EQ(ha.material, hb.material) << ray;
+        ++(g.materials[ha.material].color.z == 1 ? planeHits : landHits);  // sea: blue
+    }
+    EXPECT_GT(planeHits, kRays / 4);
+    EXPECT_GT(landHits, kRays / 20);
+    // Rays that reach the plane beside or through the tetrahedra's boxes no longer walk
+    // the tetrahedra below it.
+    EXPECT_LT(a.nodeVisits(), b.nodeVisits() * 9 / 10);
+}
+
 }  // namespace
 }  // namespace pcsg::tracer
