@@ -42,6 +42,15 @@ const std::string kCsgAbove = std::string(testing::kSierpinski)
                                   .replace(std::string(testing::kSierpinski).find("{c = 4} S"), 9,
                                            "{c = 4} S \\ move(0,0,0.5) uscale(0.4) sphere");
 
+// Every instance unique (h differs in each, and the sub-graph reads it), as a terrain's
+// patches: nothing to share, so no top level.
+const char* kUnique = R"(
+{n = 5; h = 1} T
+T if(n > 0, 2, 1)
+1: T -> move(0,0,h*0.01) scale(1.5, 20, 20) sphere
+2: T -> {n = n-1; h = 2*h} move(1,0,0) uscale(0.5) T ∪ {n = n-1; h = 2*h+1} move(-1,0,0) uscale(0.5) T
+)";
+
 struct Result {
     size_t copies = 0, instances = 0, hits = 0;
     bool built = false;
@@ -115,6 +124,13 @@ TEST(TopLevel, FlowersInheritTheirCopiesMaterialsAndHitTheWalksSurfaces) {
 TEST(TopLevel, TiesBetweenCopiesGoByTheInstancePathAsInTheWalk) {
     const Result r = compareWithGraphWalk(kTwins, 1500, 1.5);
     ASSERT_TRUE(r.built);
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, UniqueInstancesAreLeftToTheWalk) {
+    // (a budget that holds only the deeper levels: many copies, each its own instance)
+    const Result r = compareWithGraphWalk(kUnique, 1500, 1.5, 64u << 10);
+    EXPECT_FALSE(r.built);
     EXPECT_GT(r.hits, 300u);
 }
 
