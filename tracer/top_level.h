@@ -39,8 +39,9 @@ namespace pcsg::tracer {
 
 class TopLevel {
   public:
-    // Node visits above the cuts before the top level is refused.
-    static constexpr uint64_t kMaxVisits = 1u << 16;
+    // Node visits above the cuts before the top level is refused (a few hundred copies; a
+    // terrain's dry runs, which find no cuts, stop there: 4 tries of ~2 M instructions).
+    static constexpr uint64_t kMaxVisits = 1u << 13;
 
     // The top level of the scene, cut where `cache` expands, or nullptr (refused, see
     // above). Throws RuntimeError when unrolling meets a run-time error.
