@@ -195,6 +195,35 @@ UnrollCache& TraceScene::expansionCache() const {
     return *expansionCache_;
 }
 
+const TopLevel* TraceScene::buildTopLevel(uint32_t maxTries) const {
+    if (const TopLevel* t = topLevel()) return t;
+    if (!useBounds || !instanceBoxes_ || expansionBytes == 0 || !twoLevel) return nullptr;
+    const std::unique_lock lock(topMutex_, std::try_to_lock);
+    if (!lock.owns_lock() || topTries_ >= maxTries) return nullptr;
+    ++topTries_;
+    try {
+        topOwned_ = TopLevel::build(*this, expansionCache(), expansionBytes);
+    } catch (const RuntimeError&) {
+        return nullptr;  // (the walk raises it where a ray meets it)
+    }
+    top_.store(topOwned_.get(), std::memory_order_release);
+    return topOwned_.get();
+}
+
+// The scene's top level, built (tried) once kWalksBeforeTop rays entered the scene through
+// the walk, and again, at most every kWalksBeforeTop walks, while the expansion cache makes
+// new instances (it cuts only where the cache has expanded).
+const TopLevel* Tracer::topLevel() {
+    if (!expansion_) return nullptr;  // (its scratch space is the expansions')
+    if (const TopLevel* t = scene_.topLevel()) return t;
+    if (walks_ < nextTopTry_) return nullptr;
+    const uint64_t made = expansion_->cache().expansions();
+    if (made == expansionsTried_) return nullptr;
+    nextTopTry_ = walks_ + kWalksBeforeTop;
+    expansionsTried_ = made;
+    return scene_.buildTopLevel();
+}
+
 // The unrolled instance to trace instead of walking below S-node n, if there is one.
 const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t depth,
                                            std::optional<InstanceBoxes::Key>& key) {
@@ -263,19 +292,25 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
-    if (anyHit_ && expansion_ &&
-        occluder_.occludes(*expansion_, g_.scene.settings.maxDepth, r, tmin, tmax))
-        return true;
-    if (scene_.useBounds) {
-        double t0 = tmin, t1 = tmax;
-        if (!clipToBox(scene_.bounds_.node[g_.axiom], origin, dir, t0, t1)) return false;
-    }
     Hit hit;
     double best = tmax;
-    if (!first(g_.axiom, r, c, tmin, best, hit)) return false;
+    if (const TopLevel* top = topLevel()) {
+        if (!top->first(r, tmin, best, hit, anyHit_, expansion_->scratch())) return false;
+    } else {
+        if (anyHit_ && expansion_ &&
+            occluder_.occludes(*expansion_, g_.scene.settings.maxDepth, r, tmin, tmax))
+            return true;
+        if (scene_.useBounds) {
+            double t0 = tmin, t1 = tmax;
+            if (!clipToBox(scene_.bounds_.node[g_.axiom], origin, dir, t0, t1)) return false;
+        }
+        ++walks_;
+        if (!first(g_.axiom, r, c, tmin, best, hit)) return false;
+    }
     out.t = hit.t;
     out.normal = hit.normal;
     out.material = hit.material;
+    out.path = hit.key;
     out.painted = hit.paint != 0;
     if (out.painted) {
         out.interior = paintInteriors_[hit.paint - 1];

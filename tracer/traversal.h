@@ -21,6 +21,10 @@
 //  - Small instances that rays keep meeting are expanded once per thread
 //    (unrolled_instances.h) and traced as flat arrays with the same matrices, so the
 //    walk below them finds the same surfaces bit for bit without re-evaluating them.
+//  - Above the depth where instances are expanded, once the cache knows that depth, a ray
+//    is traced through the two-level structure of top_level.h instead of the walk: an
+//    expansion of the graph from the axiom whose leaves are the copies of shared expanded
+//    instances (the same matrices, the same surfaces bit for bit).
 //  - Pattern space (docs/language.md section 10): a pattern lives in the frame of the paint
 //    node that applied it. Where a paint node's material has a pattern (only then), the
 //    walk records the ray as that node's frame sees it, and the hit's point in that frame
@@ -40,6 +44,7 @@
 //    out into a clear error instead of a crash.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -57,6 +62,7 @@
 #include "primitives.h"
 #include "semantics.h"
 #include "step_memo.h"
+#include "top_level.h"
 #include "unroll_cache.h"
 #include "unrolled_instances.h"
 
@@ -78,6 +84,7 @@ struct SurfaceHit {
     // surface is in (transparency.h), the paint node instance that applied its material (a
     // hash of the node and its instance path; 0: under no paint node).
     uint64_t interior = 0;
+    uint64_t path = 0;  // the instance path of the surface (what breaks ties in t)
 };
 
 // The graph with everything the walk precomputes once: its semantics (with the fused
@@ -110,6 +117,16 @@ class TraceScene {
     // Each tracer remembers the results of C- and T-steps (compiler/step_memo.h) in a table
     // of 2^stepMemoLog2 entries (of 336 bytes); 0 turns it off.
     uint32_t stepMemoLog2 = 12;
+
+    // The two-level structure (top_level.h): built where it pays, in a budget of its own
+    // as large as the expansion cache's (expansionBytes 0 turns it off too).
+    bool twoLevel = true;
+    // It, once built (nullptr: not yet, or refused).
+    const TopLevel* topLevel() const { return top_.load(std::memory_order_acquire); }
+    // Builds it now, unless another thread is building it or it was tried `maxTries` times
+    // already; returns it (nullptr: refused or not built). The tracers call it once the
+    // cache has seen enough rays to know where it expands; tests call it directly.
+    const TopLevel* buildTopLevel(uint32_t maxTries = 4) const;
 
     // What entering each node means (with the fused chains of constant T-nodes).
     const Semantics& semantics() const { return sem_; }
@@ -149,6 +166,10 @@ class TraceScene {
     std::unique_ptr<InstanceBoxes> instanceBoxes_;
     mutable std::once_flag expansionOnce_;
     mutable std::unique_ptr<UnrollCache> expansionCache_;
+    mutable std::mutex topMutex_;  // held while building the top level
+    mutable std::unique_ptr<TopLevel> topOwned_;
+    mutable std::atomic<const TopLevel*> top_{nullptr};
+    mutable uint32_t topTries_ = 0;  // (under topMutex_)
 };
 
 // The stack ran out although the walk stays within max_depth (the thread's stack is
@@ -233,6 +254,7 @@ class Tracer {
     auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
                Unrolled unrolled, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
+    const TopLevel* topLevel();
     void checkStack() {  // (inline: once per S-node visit)
         const auto here = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));
         if (here < lowWater_) lowWater_ = here;
@@ -262,6 +284,10 @@ class Tracer {
     LastOccluder occluder_;  // shadow rays: the copy of an instance that stopped the last one
     bool anyHit_ = false;
     uint64_t visits_ = 0;
+    // Rays that entered the scene's box by the walk, the count at which to try to build the
+    // top level next, and the expansion cache's count of expansions at the last try.
+    uint64_t walks_ = 0, nextTopTry_ = kWalksBeforeTop, expansionsTried_ = 0;
+    static constexpr uint64_t kWalksBeforeTop = 2048;
     uintptr_t stackLimit_ = UINTPTR_MAX;  // not yet known (0: unknown to the system)
     uintptr_t lowWater_ = UINTPTR_MAX;
 };

@@ -51,12 +51,14 @@ struct BuildArrays {
 
 class Unroller {
   public:
-    Unroller(const TraceScene& scene, UnrolledInstance& out, uint64_t maxVisits)
+    Unroller(const TraceScene& scene, UnrolledInstance& out, uint64_t maxVisits,
+             UnrolledInstance::Cuts* cuts = nullptr)
         : scene_(scene),
           sem_(scene.semantics()),
           g_(scene.graph()),
           out_(out),
           maxVisits_(maxVisits),
+          cuts_(cuts),
           paintFrames_(!scene.paintFrames.empty()) {}
 
     void run(NodeId select, uint32_t depth, const double* frame, uint64_t path) {
@@ -67,8 +69,16 @@ class Unroller {
         base_ = depth;
         const PathState s{root, pathRule(path, rule), depth, UnrolledInstance::kInherit};
         const Lent lent(out_);
-        out_.root_ = build(g_.child(select, rule), s, 0, Affine::identity());
-        if (out_.root_ != kNone) hierarchy(out_.root_);
+        finish(build(g_.child(select, rule), s, 0, Affine::identity()));
+    }
+
+    // The whole graph from the axiom, in the walk's state at the root (expandTop).
+    void runTop() {
+        double* root = pushFrame();
+        initFrame(g_, root);
+        const PathState s{root, kRootPath, 0, UnrolledInstance::kInherit};
+        const Lent lent(out_);
+        finish(build(g_.axiom, s, 0, Affine::identity()));
     }
 
   private:
@@ -128,6 +138,17 @@ class Unroller {
     using Kind = UnrolledInstance::Kind;
     using BvhNode = UnrolledInstance::BvhNode;
 
+    // The expansion's root and hierarchy; its arrays go out at their final sizes when the
+    // Lent arrays are given back.
+    void finish(uint32_t root) {
+        out_.root_ = root;
+        if (out_.root_ != kNone) hierarchy(out_.root_);
+        out_.linkSlots_ = static_cast<uint32_t>(out_.links_.size());
+        for (const UnrolledInstance::Reference& x : out_.instances_)
+            out_.linkSlots_ = std::max(out_.linkSlots_, x.instance->linkSlots_);
+        out_.instances_.shrink_to_fit();
+    }
+
     // Builds what node n holds in state s; returns its index, or kNone when it holds
     // nothing. The inverse matrices in pending_[pendingBase..] and the forward map `edge`
     // lead from the frame of the last operator above (or the S-node) to n's frame.
@@ -140,6 +161,11 @@ class Unroller {
                 return buildPrimitive(n, s, pendingBase, edge);
             case NodeKind::Select:
                 try {
+                    if (cuts_) {
+                        const uint32_t depth = sem_.selectDepth(n, s);
+                        if (const UnrolledInstance* x = cuts_->cut(n, s, depth))
+                            return buildReference(*x, s, pendingBase, edge);
+                    }
                     return buildUnary(n, s, pendingBase, edge);
                 } catch (RuntimeError& e) {
                     e.enterModule(g_.modules[g_.nodes[n].payload].name);
@@ -176,6 +202,7 @@ class Unroller {
     uint32_t buildOperator(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
         const ::pcsg::Node& node = g_.nodes[n];
         const CsgOp op = node.op();
+        if (cuts_ && op != CsgOp::Union) throw TooLarge{};  // (a top level holds unions only)
         // This operator's operands are kids_[base..] (one stack for all operators).
         const size_t base = kids_.size();
         const size_t mark = pending_.size();
@@ -222,6 +249,17 @@ class Unroller {
         out_.args_.insert(out_.args_.end(), args, args + argc);
         setChoices(x);
         out_.nodes_.push_back(x);
+        return static_cast<uint32_t>(out_.nodes_.size() - 1);
+    }
+
+    // A cut (expandTop): the expanded instance x of the S-node instance entered in state s.
+    uint32_t buildReference(const UnrolledInstance& x, const PathState& s, size_t pendingBase,
+                            const Affine& edge) {
+        if (x.empty()) return kNone;
+        Node r = emit(Kind::Instance, s.material, pendingBase, edge, x.box());
+        r.first = static_cast<uint32_t>(out_.instances_.size());
+        out_.instances_.push_back({&x, s.path});
+        out_.nodes_.push_back(r);
         return static_cast<uint32_t>(out_.nodes_.size() - 1);
     }
 
@@ -435,6 +473,7 @@ class Unroller {
     const Graph& g_;
     UnrolledInstance& out_;
     const uint64_t maxVisits_;
+    UnrolledInstance::Cuts* const cuts_;  // expandTop's (else null)
     const bool paintFrames_;
     uint64_t visits_ = 0;
     uint32_t base_ = 0;
@@ -462,7 +501,7 @@ size_t UnrolledInstance::bytes() const {
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
            matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) +
            choices_.capacity() * sizeof(uint32_t) + bvh_.capacity() * sizeof(BvhNode) +
-           links_.capacity() * sizeof(Link);
+           links_.capacity() * sizeof(Link) + instances_.capacity() * sizeof(Reference);
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
@@ -508,7 +547,8 @@ bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
     if (root_ == kNone) return false;
     double t0 = tmin, t1 = tmax;
     if (!clipToBox(nodes_[root_].box, r, t0, t1)) return false;
-    if (s.linked.size() < links_.size()) s.linked.resize(links_.size());
+    // (instances referred to need theirs too: no resizing while a link's ray is in use)
+    if (s.linked.size() < linkSlots_) s.linked.resize(linkSlots_);
     return firstAt(root_, r, tmin, tmax, hit, use, anyHit, s);
 }
 
@@ -559,6 +599,11 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                 tmax = b.t;
                 found = true;
             }
+            break;
+        }
+        case Kind::Instance: {
+            const Reference& x = instances_[node.first];
+            found = x.instance->first(rr, tmin, tmax, hit, {x.path, material, paint}, anyHit, s);
             break;
         }
         case Kind::Operator:
@@ -715,6 +760,15 @@ size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
             count = static_cast<size_t>(k);
             break;
         }
+        case Kind::Instance: {
+            const Reference& x = instances_[node.first];
+            count =
+                x.instance->spans(rr, tmin, tmax, spans,
+                                  {x.path, node.material == kInherit ? use.material : node.material,
+                                   node.material == kInherit ? use.paint : 0},
+                                  s);
+            break;
+        }
         case Kind::Operator: {
             count = combineOperands(
                 node.op, node.count, spans, tmin, tmax,
@@ -744,6 +798,21 @@ std::unique_ptr<UnrolledInstance> UnrolledInstance::expand(const TraceScene& sce
     try {
         builder.run(select, depth, frame, path);
     } catch (const TooLarge&) {
+        return nullptr;
+    }
+    return x;
+}
+
+std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts,
+                                                              uint64_t maxVisits) {
+    if (scene.graph().axiom == kNone) return nullptr;
+    auto x = std::make_unique<UnrolledInstance>();
+    Unroller builder(scene, *x, maxVisits, &cuts);
+    try {
+        builder.runTop();
+    } catch (const TooLarge&) {
+        return nullptr;
+    } catch (const Refused&) {
         return nullptr;
     }
     return x;

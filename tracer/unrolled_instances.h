@@ -28,6 +28,12 @@
 //    instance path is replayed from the S-node's path. An instance with a paint node
 //    whose material has a pattern inside is not expanded: the graph walk records that
 //    node's frame.
+//  - Two levels (top_level.h): an expansion of the whole graph from the axiom may stop at
+//    S-node instances and refer to expanded instances of their own instead (a node of
+//    kind Instance: the S-node's matrices and material as for a primitive, and its
+//    instance path, computed once, since the top level is traced from the root only; the
+//    instance referred to replays its hits' paths from that path), so that the copies of
+//    one instance share its arrays.
 #pragma once
 
 #include <cstdint>
@@ -47,7 +53,9 @@ class UnrolledInstance {
   public:
     static constexpr uint32_t kInherit = UINT32_MAX;  // material: the caller's
 
-    enum class Kind : uint8_t { Solid, Triangle, Operator };
+    // Instance: another expanded instance (instances_[first]), entered at its S-node
+    // (expandTop's only).
+    enum class Kind : uint8_t { Solid, Triangle, Operator, Instance };
 
     struct Node {
         Kind kind;
@@ -122,6 +130,24 @@ class UnrolledInstance {
                                                     uint32_t depth, const double* frame,
                                                     uint64_t path, uint64_t maxVisits);
 
+    // Where an expansion of the whole graph (expandTop) stops: the expanded instance to
+    // refer to for the S-node `select` entered in state `s` at `depth` (it must outlive the
+    // expansion), nullptr to expand the S-node in place; throws Refused to give up.
+    struct Refused {};
+    class Cuts {
+      public:
+        virtual const UnrolledInstance* cut(NodeId select, const PathState& s, uint32_t depth) = 0;
+
+      protected:
+        ~Cuts() = default;
+    };
+    // The whole graph from the axiom, cut where `cuts` says: nullptr when it takes more
+    // than `maxVisits` node visits, meets an operator other than a union, a paint node
+    // whose pattern needs the node's frame, or is refused. Throws RuntimeError when
+    // unrolling meets a run-time error. Traced with first() and Use{kRootPath, 0, 0}.
+    static std::unique_ptr<UnrolledInstance> expandTop(const TraceScene& scene, Cuts& cuts,
+                                                       uint64_t maxVisits);
+
     const Box& box() const { return nodes_[root_].box; }
     bool empty() const { return root_ == kNone; }
     // S-nodes nested below the instance's own (the expansion is used only where the
@@ -155,6 +181,13 @@ class UnrolledInstance {
     std::vector<uint32_t> choices_;  // bit 31: a rule of an S-node, else an operand
     std::vector<BvhNode> bvh_;
     std::vector<Link> links_;
+    // Instance nodes: the instance and the S-node's instance path (from the root).
+    struct Reference {
+        const UnrolledInstance* instance;
+        uint64_t path;
+    };
+    std::vector<Reference> instances_;
+    uint32_t linkSlots_ = 0;  // Scratch::linked entries needed, instances referred to included
     uint32_t root_ = kNone;
     uint32_t levels_ = 0;
     uint32_t bvhLeaves_ = 0;

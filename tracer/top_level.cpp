@@ -1,0 +1,82 @@
+// The two-level structure: see top_level.h.
+#include "top_level.h"
+
+#include <unordered_map>
+
+#include "traversal.h"
+
+namespace pcsg::tracer {
+
+// Where expandTop stops: the expanded instances, one per (instance key, depth), shared by
+// their copies. A dry run only counts the copies and the instances (it refers every copy
+// to an empty instance), so that a scene whose instances are all unique is refused before
+// any is expanded.
+class TopLevel::Cuts final : public UnrolledInstance::Cuts {
+  public:
+    Cuts(const TraceScene& scene, const UnrollCache& cache, size_t maxBytes, TopLevel& out,
+         bool dry)
+        : scene_(scene), cache_(cache), maxBytes_(maxBytes), out_(out), dry_(dry) {}
+
+    size_t instances() const { return index_.size(); }
+
+    const UnrolledInstance* cut(NodeId select, const PathState& s, uint32_t depth) override {
+        const InstanceBoxes& boxes = *scene_.instanceBoxes();
+        if (!boxes.unrollAt(select, depth)) return nullptr;
+        const UnrollCache::Level level = cache_.level(select, depth);
+        if (level.built == 0 || level.refused > 0) return nullptr;  // expanded deeper, if at all
+        if (level.off) throw UnrolledInstance::Refused{};  // the cache found them not worth it
+        ++out_.copies_;
+        const InstanceBoxes::Key k = boxes.keyOf(select, s.frame, s.path);
+        const auto [it, added] = index_.try_emplace(Slot{k, depth}, kNone);
+        if (dry_) return &empty_;
+        if (!added) return it->second == kNone ? nullptr : out_.owned_[it->second].get();
+        auto x = UnrolledInstance::expand(scene_, select, depth, s.frame, s.path,
+                                          boxes.maxUnrollWeight());
+        if (!x || x->bytes() > maxBytes_ / 8) return nullptr;  // (noted: expanded in place)
+        if (depth + x->levels() > scene_.graph().scene.settings.maxDepth)
+            throw UnrolledInstance::Refused{};  // (the walk raises the error)
+        out_.bytes_ += x->bytes();
+        it->second = static_cast<uint32_t>(out_.owned_.size());
+        out_.owned_.push_back(std::move(x));
+        const size_t n = out_.owned_.size();
+        if (out_.bytes_ > maxBytes_ || (n > 64 && 2 * n > out_.copies_))
+            throw UnrolledInstance::Refused{};
+        return out_.owned_.back().get();
+    }
+
+  private:
+    struct Slot {
+        InstanceBoxes::Key key;
+        uint32_t depth;
+        bool operator==(const Slot&) const = default;
+    };
+    struct SlotHash {
+        size_t operator()(const Slot& s) const { return s.key.a ^ (s.key.b * 31) ^ s.depth; }
+    };
+    const TraceScene& scene_;
+    const UnrollCache& cache_;
+    const size_t maxBytes_;
+    TopLevel& out_;
+    const bool dry_;
+    const UnrolledInstance empty_;
+    std::unordered_map<Slot, uint32_t, SlotHash> index_;  // into owned_ (kNone: refused)
+};
+
+std::unique_ptr<TopLevel> TopLevel::build(const TraceScene& scene, const UnrollCache& cache,
+                                          size_t maxBytes) {
+    if (!scene.instanceBoxes() || maxBytes == 0) return nullptr;
+    auto t = std::make_unique<TopLevel>();
+    Cuts dry(scene, cache, maxBytes, *t, true);
+    if (!UnrolledInstance::expandTop(scene, dry, kMaxVisits) || dry.instances() == 0 ||
+        2 * dry.instances() > t->copies_)
+        return nullptr;
+    t->copies_ = 0;
+    Cuts cuts(scene, cache, maxBytes, *t, false);
+    t->top_ = UnrolledInstance::expandTop(scene, cuts, kMaxVisits);
+    if (!t->top_ || t->top_->empty() || t->owned_.empty()) return nullptr;
+    t->bytes_ += t->top_->bytes();
+    if (t->bytes_ > maxBytes) return nullptr;
+    return t;
+}
+
+}  // namespace pcsg::tracer

@@ -1,0 +1,68 @@
+// The two-level structure (as Embree's instancing): above the depth where instances are
+// expanded (unrolled_instances.h), a ray no longer walks the cyclic graph (S-node
+// culling, instance keys, cache look-ups, C-node memo, T-node maps: ~160 instructions a
+// node visit) but one expansion of the whole graph from the axiom whose leaves are the
+// copies of expanded instances, each a chain of inverse matrices and a reference to the
+// one UnrolledInstance its copies share, under the expansions' own four-wide BVH over the
+// copies' boxes in the top frame.
+//
+//  - One mechanism: the top level is an UnrolledInstance (expandTop) whose nodes of kind
+//    Instance refer to the expanded instances this class owns. Above the cuts it takes
+//    the graph walk's steps (semantics.h) in the same order, so a copy's ray is mapped by
+//    the same matrices, in the same order, as the walk maps it; a hit's path is the
+//    top level's path to the S-node followed by the instance's own; materials are
+//    inherited from the paint nodes above as the walk gives them. Images do not change.
+//  - Where it cuts: at the first S-node on a path where the tracer would hand the ray to
+//    an expanded instance (InstanceBoxes::unrollAt) and the expansion cache has built
+//    instances of that (module, depth) without refusing one as too large; elsewhere it
+//    expands in place. Copies are shared by their instance key (and depth).
+//  - When it is refused (nullptr, the walk as before): an operator other than a union
+//    above the cuts, a paint node whose pattern needs its frame, a level where the cache
+//    stopped expanding (a terrain's patches, each used by a few rays: every instance
+//    unique), more than half as many instances as copies, more than `maxBytes` in all
+//    (top and instances), more than kMaxVisits node visits above the cuts, an instance
+//    whose deepest S-node passes max_depth, or a run-time error (the walk raises it where
+//    a ray meets it).
+//  - When it is built: by TraceScene::buildTopLevel, which a tracer calls once the
+//    expansion cache has seen a few thousand rays enter the scene (so that the cuts are
+//    known); per TraceScene, so per frame of a sequence. Immutable once built.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "unroll_cache.h"
+#include "unrolled_instances.h"
+
+namespace pcsg::tracer {
+
+class TopLevel {
+  public:
+    // Node visits above the cuts before the top level is refused (a few hundred copies; a
+    // terrain's dry runs, which find no cuts, stop there: 4 tries of ~2 M instructions).
+    static constexpr uint64_t kMaxVisits = 1u << 13;
+
+    // The top level of the scene, cut where `cache` expands, or nullptr (refused, see
+    // above). Throws RuntimeError when unrolling meets a run-time error.
+    static std::unique_ptr<TopLevel> build(const TraceScene& scene, const UnrollCache& cache,
+                                           size_t maxBytes);
+
+    // The nearest surface as Tracer::first from the axiom finds it (world ray).
+    bool first(const LocalRay& r, double tmin, double& tmax, Hit& hit, bool anyHit,
+               UnrolledInstance::Scratch& s) const {
+        return top_->first(r, tmin, tmax, hit, {kRootPath, 0, 0}, anyHit, s);
+    }
+
+    size_t bytes() const { return bytes_; }  // the top level and the instances it owns
+    size_t copies() const { return copies_; }
+    size_t instances() const { return owned_.size(); }
+
+  private:
+    class Cuts;
+    std::vector<std::unique_ptr<UnrolledInstance>> owned_;
+    std::unique_ptr<UnrolledInstance> top_;
+    size_t bytes_ = 0, copies_ = 0;
+};
+
+}  // namespace pcsg::tracer

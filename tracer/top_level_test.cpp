@@ -1,0 +1,144 @@
+// The two-level structure (top_level.h): for many random rays it finds the graph walk's
+// hits exactly (t, normal, instance path, material), shadow rays included; copies share
+// their instances; it is refused where the part above the cuts is not all unions.
+#include "top_level.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "bounds.h"
+#include "test_support.h"
+#include "traversal.h"
+
+namespace pcsg::tracer {
+namespace {
+
+using testing::compile;
+using testing::eagerExpansion;
+
+// Flower heads (test_support.h's kFlower): painted petals, an unpainted centre that takes
+// the material of each copy's paint node, copies under rotations and a shear.
+const std::string kFlowers = std::string(testing::kFlower)
+                                 .replace(std::string(testing::kFlower).find("{p = 21} F"), 10,
+                                          "material red { color <1,0,0> }\n"
+                                          "{p = 21} (F ∪ paint(red) move(1.2,0,0) rotx(30) F ∪ "
+                                          "move(-1.2,0,0.3) zshear(0.2, 0.1) F ∪"
+                                          " move(0,0,-1) uscale(0.7) F)");
+
+// Two copies of one instance in the same place, in different materials: every hit is a tie
+// in t that the instance path decides.
+const char* kTwins = R"(
+material red { color <1,0,0> }
+material blue { color <0,0,1> }
+{n = 3} (paint(blue) T ∪ paint(red) T ∪ move(0,0,-2) plane)
+T if(n > 0, 2, 1)
+1: T -> sphere
+2: T -> {n = n-1} (move(1,0,0) uscale(0.5) T ∪ move(-1,0,0) uscale(0.5) T)
+)";
+
+// A difference above the recursion: no top level, the walk as before.
+const std::string kCsgAbove = std::string(testing::kSierpinski)
+                                  .replace(std::string(testing::kSierpinski).find("{c = 4} S"), 9,
+                                           "{c = 4} S \\ move(0,0,0.5) uscale(0.4) sphere");
+
+// Every instance unique (h differs in each, and the sub-graph reads it), as a terrain's
+// patches: nothing to share, so no top level.
+const char* kUnique = R"(
+{n = 5; h = 1} T
+T if(n > 0, 2, 1)
+1: T -> move(0,0,h*0.01) scale(1.5, 20, 20) sphere
+2: T -> {n = n-1; h = 2*h} move(1,0,0) uscale(0.5) T ∪ {n = n-1; h = 2*h+1} move(-1,0,0) uscale(0.5) T
+)";
+
+struct Result {
+    size_t copies = 0, instances = 0, hits = 0;
+    bool built = false;
+};
+
+// Fires n random rays at the scene: first through the walk (so that the expansion cache
+// learns where it expands), then builds the top level and fires them again, comparing
+// every first hit and shadow ray with a scene that only walks the graph. `expansionBytes`:
+// the budget of the expansion cache (and of the top level).
+Result compareWithGraphWalk(const std::string& text, int n, double spread,
+                            size_t expansionBytes = 16u << 20) {
+    Result out;
+    auto c = compile(text);
+    if (!c->graph) return out;
+    const Graph& g = *c->graph;
+    TraceScene plain(g, computeBounds(g), true, eagerExpansion());
+    plain.expansionBytes = 0;
+    TraceScene twoLevel(g, computeBounds(g), true, eagerExpansion());
+    twoLevel.expansionBytes = expansionBytes;
+    Tracer a(plain), b(twoLevel);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<Vec3> o, d;
+    for (int i = 0; i < n; ++i) {
+        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
+        const Vec3 target{u(rng) * spread, u(rng) * spread, u(rng) * spread + 0.5};
+        d.push_back(normalize(target - o.back()));
+    }
+    SurfaceHit warm;
+    for (int round = 0; round < 2; ++round)
+        for (int i = 0; i < n; ++i) b.firstHit(o[i], d[i], 1e-4, 1e7, warm);
+    const TopLevel* top = twoLevel.buildTopLevel();
+    out.built = top != nullptr;
+    if (top) out.copies = top->copies(), out.instances = top->instances();
+    for (int i = 0; i < n; ++i) {
+        SurfaceHit ha, hb;
+        const bool fa = a.firstHit(o[i], d[i], 1e-4, 1e7, ha);
+        EXPECT_EQ(b.firstHit(o[i], d[i], 1e-4, 1e7, hb), fa) << "ray " << i;
+        EXPECT_EQ(b.anyHit(o[i], d[i], 1e-4, 1e7), fa) << "ray " << i;
+        if (fa) {  // a shadow ray that ends just before the surface
+            EXPECT_EQ(b.anyHit(o[i], d[i], 1e-4, ha.t * (1 - 1e-9)),
+                      a.anyHit(o[i], d[i], 1e-4, ha.t * (1 - 1e-9)))
+                << "ray " << i;
+        }
+        if (!fa) continue;
+        ++out.hits;
+        EXPECT_EQ(ha.t, hb.t) << "ray " << i;
+        EXPECT_EQ(ha.normal, hb.normal) << "ray " << i;
+        EXPECT_EQ(ha.path, hb.path) << "ray " << i;
+        EXPECT_EQ(ha.material, hb.material) << "ray " << i;
+    }
+    return out;
+}
+
+TEST(TopLevel, SierpinskiCopiesShareTheirInstanceAndHitTheWalksSurfaces) {
+    // (a budget too small for the whole: the cache expands the instances of a deeper level)
+    const Result r = compareWithGraphWalk(testing::sierpinski(5), 3000, 1.0, 256u << 10);
+    ASSERT_TRUE(r.built);
+    EXPECT_GE(r.copies, 16u);
+    EXPECT_EQ(r.instances, 1u);  // one instance per depth
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, FlowersInheritTheirCopiesMaterialsAndHitTheWalksSurfaces) {
+    const Result r = compareWithGraphWalk(kFlowers, 1500, 1.5);
+    ASSERT_TRUE(r.built);
+    EXPECT_GE(r.copies, 4u);
+    EXPECT_GT(r.hits, 200u);
+}
+
+TEST(TopLevel, TiesBetweenCopiesGoByTheInstancePathAsInTheWalk) {
+    const Result r = compareWithGraphWalk(kTwins, 1500, 1.5);
+    ASSERT_TRUE(r.built);
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, UniqueInstancesAreLeftToTheWalk) {
+    // (a budget that holds only the deeper levels: many copies, each its own instance)
+    const Result r = compareWithGraphWalk(kUnique, 1500, 1.5, 64u << 10);
+    EXPECT_FALSE(r.built);
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, ADifferenceAboveTheInstancesFallsBackToTheWalk) {
+    const Result r = compareWithGraphWalk(kCsgAbove, 1500, 1.0);
+    EXPECT_FALSE(r.built);
+    EXPECT_GT(r.hits, 300u);
+}
+
+}  // namespace
+}  // namespace pcsg::tracer
