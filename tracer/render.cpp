@@ -106,7 +106,8 @@ class TileRender {
           halo_(opt.adaptive > 0 ? Region{std::max(0, region.x0 - 1), std::max(0, region.y0 - 1),
                                           std::min(w_, region.x1 + 1), std::min(h_, region.y1 + 1)}
                                  : region),
-          totalWork_(tileCount(halo_) + (opt.adaptive > 0 ? tileCount(region_) : 0)),
+          totalWork_(opt.adaptive > 0 ? bandCount() * (tilesAcross(halo_) + tilesAcross(region_))
+                                      : tileCount(halo_)),
           near_(opt.adaptive) {
         rgb_.assign(halo_.pixels() * 3, 0.0f);
     }
@@ -121,21 +122,11 @@ class TileRender {
                 tbb::global_control::max_allowed_parallelism, static_cast<size_t>(opt_.threads));
         tbb::global_control stackSize(tbb::global_control::thread_stack_size, stackBytes);
         first();
-        forTiles(1, halo_, [&](Worker& wk, int y, int x0, int x1) { sampleRow(wk, y, x0, x1); });
-        if (opt_.adaptive > 0 && !stop_) {
-            // Which pixels differ from a neighbour, decided on pass 1's centres before pass 2
-            // overwrites any (a byte a pixel, where a copy of the centres took 12).
-            const uint64_t pass = ++adaptivePasses;
-            std::vector<uint8_t> differs(region_.pixels());
-            forTiles(kDecide, region_, [&](Worker& wk, int y, int x0, int x1) {
-                for (int x = x0; x < x1; ++x)
-                    differs[regionIndex(x, y)] = differsFromNeighbour(wk, pass, x, y);
-            });
-            forTiles(2, region_, [&](Worker& wk, int y, int x0, int x1) {
-                for (int x = x0; x < x1; ++x)
-                    if (differs[regionIndex(x, y)]) supersamplePixel(wk, x, y);
-            });
-        }
+        if (opt_.adaptive > 0)
+            renderInBands();
+        else
+            forTiles(1, halo_,
+                     [&](Worker& wk, int y, int x0, int x1) { sampleRow(wk, y, x0, x1); });
         if (firstError_) std::rethrow_exception(firstError_);
         if (stop_) throw RenderCancelled();
         return regionPixels();
@@ -160,6 +151,97 @@ class TileRender {
             std::copy_n(pixelAt(rgb_, region_.x0, y), row,
                         out.data() + static_cast<size_t>(y - region_.y0) * row);
         return out;
+    }
+
+    static int tilesAcross(const Region& r) { return (r.width() + kTile - 1) / kTile; }
+    int bandCount() const { return (region_.height() + kTile - 1) / kTile; }
+
+    // Adaptive sampling (POV-Ray's +A, method 1) in bands of kTile rows of the region, so
+    // that a band's pass 2 follows its pass 1 closely and finds the expansions its rays
+    // made still in the cache (a terrain's patches: two whole-image passes had rebuilt
+    // nearly every patch for pass 2). Step k runs, on the pool, pass 1 of band k (with
+    // the image's border row above band 0 and below the last) beside pass 2 of band k-2;
+    // then decides band k-1, whose neighbours' centres are all in by then; then writes
+    // band k-2's supersampled pixels, which the decision of band k-1 was the last to read
+    // as centres. Each pixel depends only on its own samples and its neighbours' centres,
+    // so the image is the one two whole passes give.
+    void renderInBands() {
+        const int bands = bandCount();
+        const uint64_t pass = ++adaptivePasses;
+        std::vector<uint8_t> differs(region_.pixels());
+        std::vector<float> band2;  // pass 2's pixels of the band in flight, by region row
+        for (int k = 0; k < bands + 2 && !stop_; ++k) {
+            std::vector<Job> jobs;
+            if (k < bands) addTiles(jobs, 1, bandRows(k, true));
+            if (k >= 2) addTiles(jobs, 2, bandRows(k - 2, false));
+            band2.resize(static_cast<size_t>(bandRows(std::max(k - 2, 0), false).pixels()) * 3);
+            runJobs(jobs, [&](Worker& wk, int jobPass, int y, int x0, int x1) {
+                if (jobPass == 1) return sampleRow(wk, y, x0, x1);
+                const int y0 = bandRows(k - 2, false).y0;
+                for (int x = x0; x < x1; ++x)
+                    if (differs[regionIndex(x, y)])
+                        supersamplePixel(wk, x, y, bandPixel(band2, x, y - y0));
+            });
+            if (k >= 1 && k - 1 < bands && !stop_)
+                forTiles(kDecide, bandRows(k - 1, false), [&](Worker& wk, int y, int x0, int x1) {
+                    for (int x = x0; x < x1; ++x)
+                        differs[regionIndex(x, y)] = differsFromNeighbour(wk, pass, x, y);
+                });
+            if (k >= 2 && !stop_) storeBand(bandRows(k - 2, false), differs, band2);
+        }
+    }
+
+    // Band b's rows of the region (with the image's border rows of pass 1 when `halo`).
+    Region bandRows(int b, bool halo) const {
+        Region r{region_.x0, region_.y0 + b * kTile, region_.x1,
+                 std::min(region_.y1, region_.y0 + (b + 1) * kTile)};
+        if (!halo) return r;
+        r.x0 = halo_.x0, r.x1 = halo_.x1;
+        if (b == 0) r.y0 = halo_.y0;
+        if (r.y1 == region_.y1) r.y1 = halo_.y1;
+        return r;
+    }
+
+    float* bandPixel(std::vector<float>& band, int x, int row) const {
+        return band.data() + (static_cast<size_t>(row) * region_.width() + (x - region_.x0)) * 3;
+    }
+
+    // Pass 2's pixels of a band into the image.
+    void storeBand(const Region& band, const std::vector<uint8_t>& differs,
+                   std::vector<float>& band2) {
+        for (int y = band.y0; y < band.y1; ++y)
+            for (int x = band.x0; x < band.x1; ++x)
+                if (differs[regionIndex(x, y)])
+                    std::copy_n(bandPixel(band2, x, y - band.y0), 3, pixelAt(rgb_, x, y));
+    }
+
+    struct Job {
+        int pass;
+        Region tile;
+    };
+
+    static void addTiles(std::vector<Job>& jobs, int pass, const Region& area) {
+        for (int y0 = area.y0; y0 < area.y1; y0 += kTile)
+            for (int x0 = area.x0; x0 < area.x1; x0 += kTile)
+                jobs.push_back({pass, Region{x0, y0, std::min(area.x1, x0 + kTile),
+                                             std::min(area.y1, y0 + kTile)}});
+    }
+
+    // Runs row(worker, pass, y, x0, x1) over each job's tile, in parallel.
+    template <class Row>
+    void runJobs(const std::vector<Job>& jobs, Row&& row) {
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, jobs.size(), 1),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t j = range.begin(); j != range.end(); ++j) {
+                    const int pass = jobs[j].pass;
+                    auto rowOfPass = [&](Worker& wk, int y, int x0, int x1) {
+                        row(wk, pass, y, x0, x1);
+                    };
+                    if (!runTile(pass, jobs[j].tile, rowOfPass)) return;
+                }
+            },
+            tbb::simple_partitioner());
     }
 
     // Runs row(worker, y, x0, x1) over the pixels [x0, x1) of each row of the area, in tiles
@@ -317,8 +399,9 @@ class TileRender {
     }
 
     // Pass 2 of adaptive sampling, where a pixel differs: depth x depth more samples,
-    // averaged with its centre (which only this pixel reads now).
-    void supersamplePixel(Worker& wk, int x, int y) {
+    // averaged with its centre, into `out` (the image's pixel is written once the
+    // neighbours' decisions have read its centre).
+    void supersamplePixel(Worker& wk, int x, int y, float* out) {
         const float* c = pixelAt(rgb_, x, y);
         const int depth = std::max(1, opt_.adaptiveDepth);
         const double step = 1.0 / depth, range = 0.5 - step * 0.5;
@@ -327,7 +410,9 @@ class TileRender {
             const int i = s % depth, j = s / depth;
             return camera_.ray(x + 0.5 - range + i * step, y + 0.5 - range + j * step);
         });
-        store(x, y, sum / static_cast<double>(depth * depth + 1));
+        const Vec3 c2 = sum / static_cast<double>(depth * depth + 1);
+        out[0] = static_cast<float>(c2.x), out[1] = static_cast<float>(c2.y),
+        out[2] = static_cast<float>(c2.z);
     }
 
     const TraceScene& scene_;
