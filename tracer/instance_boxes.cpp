@@ -1,14 +1,12 @@
 // Exact boxes of S-node instances: see instance_boxes.h.
 #include "instance_boxes.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 #include <tbb/spin_rw_mutex.h>
 
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <type_traits>
@@ -16,6 +14,7 @@
 
 #include "key_slots.h"
 #include "primitives.h"
+#include "thread_pool.h"
 
 namespace pcsg::tracer {
 
@@ -631,28 +630,22 @@ std::shared_ptr<const KnownCounts> InstanceBoxes::prefill(NodeId start,
     const std::vector<Seed> seeds = prefillSeeds(start);
     if (seeds.size() < 2) return nullptr;
     std::vector<std::optional<KnownSubtree>> counted(seeds.size());
-    tbb::enumerable_thread_specific<std::unique_ptr<CountingWorker>> workers(
-        [this] { return std::make_unique<CountingWorker>(*this); });
+    std::vector<std::unique_ptr<CountingWorker>> workers(parallelSlots());
     std::atomic<bool> stop{false};
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, seeds.size(), 1),
-        [&](const tbb::blocked_range<size_t>& range) {
-            CountingWorker& w = *workers.local();
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                if (stop.load(std::memory_order_relaxed) ||
-                    (cancel && cancel->load(std::memory_order_relaxed)))
-                    return;
-                const Seed& sd = seeds[i];
-                Stored s;
-                if (find(sd.node, keyOf(sd.node, sd.frame.data(), sd.path), s)) continue;
-                try {
-                    counted[i] = unrollCounting(w, sd);
-                } catch (const RuntimeError&) {
-                    stop = true;
-                }
-            }
-        },
-        tbb::simple_partitioner());
+    parallelFor(seeds.size(), [&](size_t i, int slot) {
+        if (stop.load(std::memory_order_relaxed) ||
+            (cancel && cancel->load(std::memory_order_relaxed)))
+            return;
+        const Seed& sd = seeds[i];
+        Stored s;
+        if (find(sd.node, keyOf(sd.node, sd.frame.data(), sd.path), s)) return;
+        if (!workers[slot]) workers[slot] = std::make_unique<CountingWorker>(*this);
+        try {
+            counted[i] = unrollCounting(*workers[slot], sd);
+        } catch (const RuntimeError&) {
+            stop = true;
+        }
+    });
     auto known = std::make_shared<PrefillCounts>(g_, deps_, seeds.front().depth);
     for (size_t i = 0; i < seeds.size(); ++i)
         if (counted[i] && seeds[i].depth == seeds.front().depth)

@@ -2,9 +2,6 @@
 
 #include <fmt/format.h>
 #include <pthread.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -23,6 +20,7 @@
 #include "camera.h"
 #include "eval.h"
 #include "shading.h"
+#include "thread_pool.h"
 #include "traversal.h"
 
 namespace pcsg::tracer {
@@ -84,9 +82,10 @@ struct Worker {
 // Each adaptive pass of a TileRender, numbered (workers outlive a render).
 std::atomic<uint64_t> adaptivePasses{0};
 
-using Workers = tbb::enumerable_thread_specific<std::unique_ptr<Worker>>;
+// By slot of the pool (thread_pool.h): one thread at a time runs a slot.
+using Workers = std::vector<std::unique_ptr<Worker>>;
 
-// One render of a region of the image in tiles of kTile x kTile pixels on oneTBB's
+// One render of a region of the image in tiles of kTile x kTile pixels on the pool's
 // threads: pass 1 takes the stratified samples (or the pixel centres) of the region and,
 // with adaptive sampling, of a one-pixel border around it (clipped to the image); pass 2
 // supersamples where a pixel of the region differs from a 4-neighbour. The first error
@@ -116,11 +115,9 @@ class TileRender {
     // rethrows the first error.
     // `first` runs on the pool before the first tile.
     std::vector<float> run(size_t stackBytes, const std::function<void()>& first) {
-        std::unique_ptr<tbb::global_control> limit;
-        if (opt_.threads > 0)
-            limit = std::make_unique<tbb::global_control>(
-                tbb::global_control::max_allowed_parallelism, static_cast<size_t>(opt_.threads));
-        tbb::global_control stackSize(tbb::global_control::thread_stack_size, stackBytes);
+        const ParallelLimits limits(opt_.threads, stackBytes);
+        if (workers_.size() < static_cast<size_t>(parallelSlots()))
+            workers_.resize(parallelSlots());
         first();
         if (opt_.adaptive > 0)
             renderInBands();
@@ -230,48 +227,35 @@ class TileRender {
     // Runs row(worker, pass, y, x0, x1) over each job's tile, in parallel.
     template <class Row>
     void runJobs(const std::vector<Job>& jobs, Row&& row) {
-        tbb::parallel_for(
-            tbb::blocked_range<size_t>(0, jobs.size(), 1),
-            [&](const tbb::blocked_range<size_t>& range) {
-                for (size_t j = range.begin(); j != range.end(); ++j) {
-                    const int pass = jobs[j].pass;
-                    auto rowOfPass = [&](Worker& wk, int y, int x0, int x1) {
-                        row(wk, pass, y, x0, x1);
-                    };
-                    if (!runTile(pass, jobs[j].tile, rowOfPass)) return;
-                }
-            },
-            tbb::simple_partitioner());
+        parallelFor(jobs.size(), [&](size_t j, int slot) {
+            const int pass = jobs[j].pass;
+            auto rowOfPass = [&](Worker& wk, int y, int x0, int x1) { row(wk, pass, y, x0, x1); };
+            runTile(slot, pass, jobs[j].tile, rowOfPass);
+        });
     }
 
     // Runs row(worker, y, x0, x1) over the pixels [x0, x1) of each row of the area, in tiles
     // of kTile x kTile in parallel.
     template <class Row>
     void forTiles(int pass, const Region& area, Row&& row) {
-        const int tilesX = (area.width() + kTile - 1) / kTile;
-        tbb::parallel_for(
-            tbb::blocked_range<int>(0, tileCount(area), 1),
-            [&](const tbb::blocked_range<int>& range) {
-                for (int tile = range.begin(); tile != range.end(); ++tile) {
-                    const int x0 = area.x0 + (tile % tilesX) * kTile;
-                    const int y0 = area.y0 + (tile / tilesX) * kTile;
-                    const Region t{x0, y0, std::min(area.x1, x0 + kTile),
-                                   std::min(area.y1, y0 + kTile)};
-                    if (!runTile(pass, t, row)) return;
-                }
-            },
-            tbb::simple_partitioner());
+        const size_t tilesX = (area.width() + kTile - 1) / kTile;
+        parallelFor(tileCount(area), [&](size_t tile, int slot) {
+            const int x0 = area.x0 + static_cast<int>(tile % tilesX) * kTile;
+            const int y0 = area.y0 + static_cast<int>(tile / tilesX) * kTile;
+            const Region t{x0, y0, std::min(area.x1, x0 + kTile), std::min(area.y1, y0 + kTile)};
+            runTile(slot, pass, t, row);
+        });
     }
 
     // One tile; false when the render stops (an error here or elsewhere).
     template <class Row>
-    bool runTile(int pass, const Region& t, Row& row) {
+    bool runTile(int slot, int pass, const Region& t, Row& row) {
         if (stop_.load(std::memory_order_relaxed)) return false;
         if (opt_.cancel && opt_.cancel->load(std::memory_order_relaxed)) {
             stop_ = true;
             return false;
         }
-        auto& wp = workers_.local();
+        auto& wp = workers_[slot];
         if (!wp) wp = std::make_unique<Worker>(scene_);
         const double start = opt_.tileTime ? threadCpuSeconds() : 0.0;
         try {

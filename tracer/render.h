@@ -1,5 +1,5 @@
-// Rendering an image: pixels in tiles, in parallel with oneTBB, anti-aliasing. The result
-// is linear float RGB; tools/image/ writes it to a file.
+// Rendering an image: pixels in tiles, in parallel on thread_pool.h's threads, anti-aliasing. The
+// result is linear float RGB; tools/image/ writes it to a file.
 //
 //  - Every pixel's colour depends only on the pixel (fixed sample positions, no shared
 //    mutable state), so the image is the same byte for byte whatever the thread count.
@@ -13,8 +13,8 @@
 //    is made after all centres are known, so it does not depend on the tiling.
 //  - Threads: the walk recurses once per node visit, so the render runs on threads whose
 //    stacks are sized from the scene (TraceScene::stackBytesNeeded): a thread of its own
-//    with that stack calls the parallel loop, and oneTBB's workers get the same size
-//    through tbb::global_control::thread_stack_size.
+//    with that stack calls the parallel loop, and the pool's threads get the same size
+//    through ParallelLimits (thread_pool.h).
 //  - A run-time error of the scene (RuntimeError) stops the render: the first error wins
 //    (later ones from other threads are dropped), the remaining tiles are skipped, and
 //    render() rethrows it. Nothing is written.

@@ -1,15 +1,13 @@
 // A sequence's PNG files, written beside the render: see frame_writer.h.
 #include "frame_writer.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
 #include <utility>
 
 #include "png_writer.h"
+#include "thread_pool.h"
 
 namespace pcsg::tools {
 
@@ -20,12 +18,10 @@ namespace {
 std::vector<uint8_t> parallelSrgbBytes(std::span<const float> rgb, int threads) {
     constexpr size_t kChunk = 16384;
     std::vector<uint8_t> bytes(rgb.size());
-    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-    arena.execute([&] {
-        tbb::parallel_for(size_t{0}, (rgb.size() + kChunk - 1) / kChunk, [&](size_t chunk) {
-            const size_t begin = chunk * kChunk, n = std::min(kChunk, rgb.size() - begin);
-            srgbBytesInto(rgb.subspan(begin, n), std::span(bytes).subspan(begin, n));
-        });
+    const tracer::ParallelLimits limits(threads, 0);  // the render's pool, whatever its stacks
+    tracer::parallelFor((rgb.size() + kChunk - 1) / kChunk, [&](size_t chunk, int) {
+        const size_t begin = chunk * kChunk, n = std::min(kChunk, rgb.size() - begin);
+        srgbBytesInto(rgb.subspan(begin, n), std::span(bytes).subspan(begin, n));
     });
     return bytes;
 }
