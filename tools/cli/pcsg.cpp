@@ -4,8 +4,10 @@
 
 #include "commands.h"
 #include "mpi_session.h"
+#include "process_memory.h"
 
 int main(int argc, char** argv) {
+    pcsg::tools::fixMallocThresholds();
     CLI::App app{
         "pcsg: a scene compiler, ray tracer and verifier for recursive natural objects.\n"
         "A .pcsg file (a parametric rewriting system whose rules are CSG expressions) is\n"

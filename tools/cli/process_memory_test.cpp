@@ -1,0 +1,41 @@
+// The allocator's thresholds stay where they start (process_memory.h).
+#include "process_memory.h"
+
+#include <gtest/gtest.h>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+#include <cstdlib>
+#include <cstring>
+
+namespace pcsg::tools {
+namespace {
+
+#if defined(__GLIBC__)
+// Bytes in blocks with mappings of their own.
+size_t mappedBytes() {
+    return mallinfo2().hblkhd;
+}
+
+// A frame-sized block freed and allocated again gets a mapping of its own again, which
+// its free() returns: glibc's own policy would have raised the threshold past it at the
+// first free() and taken the second from the heap.
+TEST(ProcessMemory, AFreedLargeBlockDoesNotMoveTheNextIntoTheHeap) {
+    fixMallocThresholds();
+    constexpr size_t kBlock = 3 << 20;
+    for (int round = 0; round < 3; ++round) {
+        const size_t before = mappedBytes();
+        void* volatile p = std::malloc(kBlock);  // volatile: not elided
+        ASSERT_NE(p, nullptr);
+        std::memset(p, 1, kBlock);
+        EXPECT_GE(mappedBytes(), before + kBlock) << "round " << round;
+        std::free(p);
+        EXPECT_EQ(mappedBytes(), before) << "round " << round;
+    }
+}
+#endif
+
+}  // namespace
+}  // namespace pcsg::tools
