@@ -64,16 +64,31 @@ uint64_t finish(uint64_t h) {
     return h ^ (h >> 33);
 }
 
-void toDoubles(const Affine& m, double* out) {
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) out[3 * i + j] = m.l[i][j];
-    out[9] = m.t.x, out[10] = m.t.y, out[11] = m.t.z;
+uint64_t bits(double v) {
+    return std::bit_cast<uint64_t>(v);
 }
 
-void fromDoubles(const double* in, Affine& m) {
+double value(uint64_t b) {
+    return std::bit_cast<double>(b);
+}
+
+void toBits(const Affine& m, uint64_t* out) {
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) m.l[i][j] = in[3 * i + j];
-    m.t = Vec3{in[9], in[10], in[11]};
+        for (int j = 0; j < 3; ++j) out[3 * i + j] = bits(m.l[i][j]);
+    out[9] = bits(m.t.x), out[10] = bits(m.t.y), out[11] = bits(m.t.z);
+}
+
+void fromBits(const uint64_t* in, Affine& m) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) m.l[i][j] = value(in[3 * i + j]);
+    m.t = Vec3{value(in[9]), value(in[10]), value(in[11])};
+}
+
+// The values a node writes into an entry: C: its assignments; S: the rule; T: two
+// matrices of 12.
+uint32_t writesOf(const Graph& g, const Node& node) {
+    if (node.kind == NodeKind::Calc) return g.calcs[node.payload].count;
+    return node.kind == NodeKind::Select ? 1 : 24;
 }
 
 }  // namespace
@@ -113,61 +128,69 @@ StepMemoPlan::StepMemoPlan(const Graph& g, const FixedSlots* fixed) : nodes_(g.n
         p.readCount = static_cast<uint32_t>(reads.size());
         p.memoised = true;
         reads_.insert(reads_.end(), reads.begin(), reads.end());
+        maxReads_ = std::max(maxReads_, p.readCount);
+        maxWrites_ = std::max(maxWrites_, writesOf(g, node));
     }
 }
 
 StepMemo::StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2)
-    : g_(g), plan_(plan), table_(size_t{1} << entriesLog2), mask_((1u << entriesLog2) - 1) {}
+    : g_(g),
+      plan_(plan),
+      stride_(kKey + plan.maxReads() + plan.maxWrites()),
+      table_(stride_ << entriesLog2),
+      mask_((1u << entriesLog2) - 1) {
+    for (size_t i = 0; i < table_.size(); i += stride_) table_[i] = kNone;
+}
 
-bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, Entry*& e) {
+bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, uint64_t*& e) {
     uint64_t key[StepMemoPlan::kMaxReads];
     const uint32_t* reads = plan_.reads(p);
     uint64_t h = add(0, n);
     for (uint32_t i = 0; i < p.readCount; ++i) {
-        key[i] = std::bit_cast<uint64_t>(readValue(g_, reads[i], in.frame));
+        key[i] = bits(readValue(g_, reads[i], in.frame));
         h = add(h, key[i]);
     }
     const uint64_t path = p.usesPath ? in.path : 0;
     if (p.usesPath) h = add(h, path);
-    e = &table_[finish(h) & mask_];
-    bool same = e->node == n && e->path == path;
-    for (uint32_t i = 0; same && i < p.readCount; ++i) same = e->key[i] == key[i];
+    e = table_.data() + (finish(h) & mask_) * stride_;
+    bool same = e[0] == n && e[1] == path;
+    for (uint32_t i = 0; same && i < p.readCount; ++i) same = e[kKey + i] == key[i];
     if (same) {
         ++hits_;
         return true;
     }
     ++misses_;
-    e->node = kNone;  // filled in by the caller once the step has succeeded
-    e->path = path;
-    for (uint32_t i = 0; i < p.readCount; ++i) e->key[i] = key[i];
+    e[0] = kNone;  // filled in by the caller once the step has succeeded
+    e[1] = path;
+    for (uint32_t i = 0; i < p.readCount; ++i) e[kKey + i] = key[i];
     return false;
 }
 
 uint32_t StepMemo::select(NodeId n, EvalState in) {
     const StepMemoPlan::NodePlan& p = plan_.of(n);
     if (!p.memoised) return selectRule(g_, n, in);
-    Entry* e;
-    if (lookup(n, p, in, e)) return static_cast<uint32_t>(e->out[0]);
+    uint64_t* e;
+    if (lookup(n, p, in, e)) return static_cast<uint32_t>(out(e)[0]);
     const uint32_t rule = selectRule(g_, n, in);
-    e->out[0] = rule;
-    e->node = n;
+    out(e)[0] = rule;
+    e[0] = n;
     return rule;
 }
 
-void StepMemo::calc(NodeId n, EvalState in, double* out) {
+void StepMemo::calc(NodeId n, EvalState in, double* frame) {
     const StepMemoPlan::NodePlan& p = plan_.of(n);
-    if (!p.memoised) return applyCalc(g_, n, in, out);
+    if (!p.memoised) return applyCalc(g_, n, in, frame);
     const Calc& c = g_.calcs[g_.nodes[n].payload];
     const Assignment* as = g_.assignments.data() + c.first;
-    Entry* e;
+    uint64_t* e;
     if (lookup(n, p, in, e)) {
-        std::memcpy(out, in.frame, g_.slotCount() * sizeof(double));
-        for (uint32_t i = 0; i < c.count; ++i) out[as[i].slot] = e->out[i];
+        std::memcpy(frame, in.frame, g_.slotCount() * sizeof(double));
+        for (uint32_t i = 0; i < c.count; ++i) frame[as[i].slot] = value(out(e)[i]);
         return;
     }
-    applyCalc(g_, n, in, out);
-    for (uint32_t i = 0; i < c.count; ++i) e->out[i] = out[as[i].slot];
-    e->node = n;
+    applyCalc(g_, n, in, frame);
+    for (uint32_t i = 0; i < c.count; ++i) out(e)[i] = bits(frame[as[i].slot]);
+    e[0] = n;
 }
 
 void StepMemo::transform(NodeId n, EvalState in, Affine& forward, Affine& inverse) {
@@ -177,17 +200,17 @@ void StepMemo::transform(NodeId n, EvalState in, Affine& forward, Affine& invers
         inverse = forward.inverse();
         return;
     }
-    Entry* e;
+    uint64_t* e;
     if (lookup(n, p, in, e)) {
-        fromDoubles(e->out, forward);
-        fromDoubles(e->out + 12, inverse);
+        fromBits(out(e), forward);
+        fromBits(out(e) + 12, inverse);
         return;
     }
     forward = transformMatrix(g_, n, in);
     inverse = forward.inverse();
-    toDoubles(forward, e->out);
-    toDoubles(inverse, e->out + 12);
-    e->node = n;
+    toBits(forward, out(e));
+    toBits(inverse, out(e) + 12);
+    e[0] = n;
 }
 
 }  // namespace pcsg

@@ -46,13 +46,19 @@ class StepMemoPlan {
     };
     const NodePlan& of(NodeId n) const { return nodes_[n]; }
     const uint32_t* reads(const NodePlan& p) const { return reads_.data() + p.firstRead; }
+    // The most values a memoised node reads and writes: what an entry of the memo holds.
+    uint32_t maxReads() const { return maxReads_; }
+    uint32_t maxWrites() const { return maxWrites_; }
 
   private:
     std::vector<NodePlan> nodes_;
     std::vector<uint32_t> reads_;
+    uint32_t maxReads_ = 0, maxWrites_ = 0;
 };
 
-// Per thread: the table (a few thousand entries, a fixed size).
+// Per thread: the table (a few thousand entries, a fixed number). An entry holds as many
+// read and written values as the plan's nodes need at most (a Sierpinski tetrahedron's
+// one slot: 32 bytes, where room for kMaxReads and kMaxWrites took 336).
 class StepMemo {
   public:
     StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2 = 12);
@@ -65,21 +71,23 @@ class StepMemo {
     void transform(NodeId n, EvalState in, Affine& forward, Affine& inverse);
 
     uint64_t hits() const { return hits_; }
+    // The table's size.
+    size_t bytes() const { return table_.size() * sizeof(uint64_t); }
     uint64_t misses() const { return misses_; }
 
   private:
-    struct Entry {
-        NodeId node = kNone;
-        uint64_t path = 0;
-        uint64_t key[StepMemoPlan::kMaxReads];  // the values read, as bits
-        double out[StepMemoPlan::kMaxWrites];   // C: written values; T: forward, inverse
-    };
-    // The entry for (n, in): found (true) or to fill (false); `key` gets the read values.
-    bool lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, Entry*& e);
+    // An entry is stride_ words: the node (kNone: empty), the path, plan_.maxReads() values
+    // read, then plan_.maxWrites() values written (C: the new values; S: the rule; T:
+    // forward, inverse), doubles as their bits.
+    static constexpr uint32_t kKey = 2;
+    // The entry for (n, in): found (true) or to fill (false); its key gets the read values.
+    bool lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, uint64_t*& e);
+    uint64_t* out(uint64_t* e) const { return e + kKey + plan_.maxReads(); }
 
     const Graph& g_;
     const StepMemoPlan& plan_;
-    std::vector<Entry> table_;
+    size_t stride_;
+    std::vector<uint64_t> table_;
     uint32_t mask_;
     uint64_t hits_ = 0, misses_ = 0;
 };

@@ -145,5 +145,31 @@ TEST(StepMemo, AStepThatFailsIsNotRemembered) {
     EXPECT_EQ(failing, 1);
 }
 
+// An entry holds what the graph's memoised nodes read and write at most, not room for
+// kMaxReads and kMaxWrites: the Sierpinski tetrahedron's S-node and C-node read and write
+// one value each.
+TEST(StepMemo, EntriesAreSizedToTheGraph) {
+    auto c = compile(R"(
+{c=6} S
+S if(c > 0, 2, 1)
+1: S -> tetrahedron
+2: S -> {c=c-1} ( move(0.5,0.5,0.5) uscale(0.5) S ∪ move(-0.5,-0.5,0.5) uscale(0.5) S )
+)");
+    ASSERT_TRUE(c->graph) << c->errors();
+    const StepMemoPlan plan(*c->graph);
+    EXPECT_EQ(plan.maxReads(), 1u);
+    EXPECT_EQ(plan.maxWrites(), 1u);
+    const StepMemo memo(*c->graph, plan, 12);
+    EXPECT_EQ(memo.bytes(), 4096u * 4 * sizeof(uint64_t));  // node, path, c, the result
+
+    // kScene: a T-node's two matrices, and a key of n, b and the clock at most.
+    auto k = compile(kScene);
+    ASSERT_TRUE(k->graph) << k->errors();
+    const StepMemoPlan full(*k->graph);
+    EXPECT_EQ(full.maxWrites(), 24u);
+    EXPECT_GE(full.maxReads(), 2u);
+    EXPECT_LT(full.maxReads(), StepMemoPlan::kMaxReads);
+}
+
 }  // namespace
 }  // namespace pcsg
