@@ -8,9 +8,9 @@
 namespace pcsg::tracer {
 
 // Where expandTop stops: the expanded instances, one per (instance key, depth), shared by
-// their copies. A dry run only counts the copies and the instances (it refers every copy
-// to an empty instance), so that a scene whose instances are all unique is refused before
-// any is expanded.
+// their copies, and with the expansion cache where it has built them. A dry run only counts the
+// copies and the instances (it refers every copy to an empty instance), so that a scene whose
+// instances are all unique is refused before any is expanded.
 class TopLevel::Cuts final : public UnrolledInstance::Cuts {
   public:
     Cuts(const TraceScene& scene, const UnrollCache& cache, size_t maxBytes, TopLevel& out,
@@ -30,8 +30,7 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
         const auto [it, added] = index_.try_emplace(Slot{k, depth}, kNone);
         if (dry_) return &empty_;
         if (!added) return it->second == kNone ? nullptr : out_.owned_[it->second].get();
-        auto x = UnrolledInstance::expand(scene_, select, depth, s.frame, s.path,
-                                          boxes.maxUnrollWeight());
+        std::shared_ptr<const UnrolledInstance> x = instance(k, select, depth, s);
         if (!x || x->bytes() > maxBytes_ / 8) return nullptr;  // (noted: expanded in place)
         if (depth + x->levels() > scene_.graph().scene.settings.maxDepth)
             throw UnrolledInstance::Refused{};  // (the walk raises the error)
@@ -45,6 +44,18 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
     }
 
   private:
+    // The cache's instance of key k (so that it exists once), or, where the cache has none
+    // built, one of the top level's own.
+    std::shared_ptr<const UnrolledInstance> instance(const InstanceBoxes::Key& k, NodeId select,
+                                                     uint32_t depth, const PathState& s) {
+        if (auto x = cache_.share(k)) {
+            ++out_.shared_;
+            return x;
+        }
+        return UnrolledInstance::expand(scene_, select, depth, s.frame, s.path,
+                                        scene_.instanceBoxes()->maxUnrollWeight());
+    }
+
     struct Slot {
         InstanceBoxes::Key key;
         uint32_t depth;

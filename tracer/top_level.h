@@ -7,7 +7,9 @@
 // copies' boxes in the top frame.
 //
 //  - One mechanism: the top level is an UnrolledInstance (expandTop) whose nodes of kind
-//    Instance refer to the expanded instances this class owns. Above the cuts it takes
+//    Instance refer to the expanded instances this class holds: the expansion cache's own
+//    where it has built them (UnrollCache::share: each exists once, and lives on here
+//    when the cache evicts it), else expanded here. Above the cuts it takes
 //    the graph walk's steps (semantics.h) in the same order, so a copy's ray is mapped by
 //    the same matrices, in the same order, as the walk maps it; a hit's path is the
 //    top level's path to the S-node followed by the instance's own; materials are
@@ -54,15 +56,20 @@ class TopLevel {
         return top_->first(r, tmin, tmax, hit, {kRootPath, 0, 0}, anyHit, s);
     }
 
-    size_t bytes() const { return bytes_; }  // the top level and the instances it owns
+    size_t bytes() const { return bytes_; }  // the top level and the instances it holds
     size_t copies() const { return copies_; }
     size_t instances() const { return owned_.size(); }
+    // Instances it holds that the expansion cache had built (and shares with it).
+    size_t sharedInstances() const { return shared_; }
+    const UnrolledInstance& instance(size_t i) const { return *owned_[i]; }
 
   private:
     class Cuts;
-    std::vector<std::unique_ptr<UnrolledInstance>> owned_;
+    // The instances the copies refer to: the expansion cache's where it had built them
+    // (which stay valid here when the cache evicts them), else the top level's own.
+    std::vector<std::shared_ptr<const UnrolledInstance>> owned_;
     std::unique_ptr<UnrolledInstance> top_;
-    size_t bytes_ = 0, copies_ = 0;
+    size_t bytes_ = 0, copies_ = 0, shared_ = 0;
 };
 
 }  // namespace pcsg::tracer
