@@ -1,6 +1,7 @@
 // The two-level structure: see top_level.h.
 #include "top_level.h"
 
+#include <algorithm>
 #include <unordered_map>
 
 #include "traversal.h"
@@ -19,6 +20,14 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
 
     size_t instances() const { return index_.size(); }
 
+    // kMaxVisits, and kVisitsPerCopy more for each copy met, within the budget (at
+    // kBytesPerVisit): a scene of many copies (Sierpinski order 12's 4,096) is not refused
+    // for them, one without any (a terrain's upper levels) stops as soon as before.
+    uint64_t maxVisits() const override {
+        return std::min<uint64_t>(kMaxVisits + kVisitsPerCopy * out_.copies_,
+                                  std::max<uint64_t>(kMaxVisits, maxBytes_ / kBytesPerVisit));
+    }
+
     const UnrolledInstance* cut(NodeId select, const PathState& s, uint32_t depth) override {
         const InstanceBoxes& boxes = *scene_.instanceBoxes();
         if (!boxes.unrollAt(select, depth)) return nullptr;
@@ -28,7 +37,11 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
         ++out_.copies_;
         const InstanceBoxes::Key k = boxes.keyOf(select, s.frame, s.path);
         const auto [it, added] = index_.try_emplace(Slot{k, depth}, kNone);
-        if (dry_) return &empty_;
+        if (dry_) {  // (as the real run refuses, so that unique copies stop it early)
+            const size_t n = index_.size();
+            if (n > 64 && 2 * n > out_.copies_) throw UnrolledInstance::Refused{};
+            return &empty_;
+        }
         if (!added) return it->second == kNone ? nullptr : out_.owned_[it->second].get();
         std::shared_ptr<const UnrolledInstance> x = instance(k, select, depth, s);
         if (!x || x->bytes() > maxBytes_ / 8) return nullptr;  // (noted: expanded in place)
@@ -78,12 +91,12 @@ std::unique_ptr<TopLevel> TopLevel::build(const TraceScene& scene, const UnrollC
     if (!scene.instanceBoxes() || maxBytes == 0) return nullptr;
     auto t = std::make_unique<TopLevel>();
     Cuts dry(scene, cache, maxBytes, *t, true);
-    if (!UnrolledInstance::expandTop(scene, dry, kMaxVisits) || dry.instances() == 0 ||
+    if (!UnrolledInstance::expandTop(scene, dry) || dry.instances() == 0 ||
         2 * dry.instances() > t->copies_)
         return nullptr;
     t->copies_ = 0;
     Cuts cuts(scene, cache, maxBytes, *t, false);
-    t->top_ = UnrolledInstance::expandTop(scene, cuts, kMaxVisits);
+    t->top_ = UnrolledInstance::expandTop(scene, cuts);
     if (!t->top_ || t->top_->empty() || t->owned_.empty()) return nullptr;
     t->bytes_ += t->top_->bytes();
     if (t->bytes_ > maxBytes) return nullptr;

@@ -22,9 +22,9 @@
 //    above the cuts, a paint node whose pattern needs its frame, a level where the cache
 //    stopped expanding (a terrain's patches, each used by a few rays: every instance
 //    unique), more than half as many instances as copies, more than `maxBytes` in all
-//    (top and instances), more than kMaxVisits node visits above the cuts, an instance
-//    whose deepest S-node passes max_depth, or a run-time error (the walk raises it where
-//    a ray meets it).
+//    (top and instances), more node visits above the cuts than kMaxVisits and a few per
+//    copy met (see below), an instance whose deepest S-node passes max_depth, or a
+//    run-time error (the walk raises it where a ray meets it).
 //  - When it is built: by TraceScene::buildTopLevel, which a tracer calls once the
 //    expansion cache has seen a few thousand rays enter the scene (so that the cuts are
 //    known); per TraceScene, so per frame of a sequence. Immutable once built.
@@ -41,9 +41,13 @@ namespace pcsg::tracer {
 
 class TopLevel {
   public:
-    // Node visits above the cuts before the top level is refused (a few hundred copies; a
-    // terrain's dry runs, which find no cuts, stop there: 4 tries of ~2 M instructions).
+    // Node visits above the cuts before the top level is refused: kMaxVisits, and
+    // kVisitsPerCopy more for each copy met so far, but no more than the budget's bytes
+    // at kBytesPerVisit (the top level's own arrays take ~60 bytes a visit). A terrain's
+    // dry runs, which find no cuts, stop at kMaxVisits (4 tries of ~2 M instructions).
     static constexpr uint64_t kMaxVisits = 1u << 13;
+    static constexpr uint64_t kVisitsPerCopy = 16;
+    static constexpr uint64_t kBytesPerVisit = 64;
 
     // The top level of the scene, cut where `cache` expands, or nullptr (refused, see
     // above). Throws RuntimeError when unrolling meets a run-time error.

@@ -62,14 +62,15 @@ struct Result {
 // every first hit and shadow ray with a scene that only walks the graph. `expansionBytes`:
 // the budget of the expansion cache (and of the top level).
 Result compareWithGraphWalk(const std::string& text, int n, double spread,
-                            size_t expansionBytes = 16u << 20) {
+                            size_t expansionBytes = 16u << 20,
+                            const InstanceBoxOptions& options = eagerExpansion()) {
     Result out;
     auto c = compile(text);
     if (!c->graph) return out;
     const Graph& g = *c->graph;
-    TraceScene plain(g, computeBounds(g), true, eagerExpansion());
+    TraceScene plain(g, computeBounds(g), true, options);
     plain.expansionBytes = 0;
-    TraceScene twoLevel(g, computeBounds(g), true, eagerExpansion());
+    TraceScene twoLevel(g, computeBounds(g), true, options);
     twoLevel.expansionBytes = expansionBytes;
     Tracer a(plain), b(twoLevel);
     std::mt19937_64 rng(11);
@@ -112,6 +113,18 @@ TEST(TopLevel, SierpinskiCopiesShareTheirInstanceAndHitTheWalksSurfaces) {
     ASSERT_TRUE(r.built);
     EXPECT_GE(r.copies, 16u);
     EXPECT_EQ(r.instances, 1u);  // one instance per depth
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, CopiesBeyondTheVisitsOfAFewHundredAreNotRefused) {
+    // (only small instances are expanded, those of a deep level: thousands of copies, whose
+    // top level takes more than kMaxVisits visits above them)
+    InstanceBoxOptions small = eagerExpansion();
+    small.maxUnrollWeight = 200;
+    const Result r = compareWithGraphWalk(testing::sierpinski(8), 3000, 1.0, 4u << 20, small);
+    ASSERT_TRUE(r.built);
+    EXPECT_GT(r.copies, TopLevel::kMaxVisits / 4);
+    EXPECT_EQ(r.instances, 1u);
     EXPECT_GT(r.hits, 300u);
 }
 

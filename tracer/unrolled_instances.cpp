@@ -153,7 +153,7 @@ class Unroller {
     // nothing. The inverse matrices in pending_[pendingBase..] and the forward map `edge`
     // lead from the frame of the last operator above (or the S-node) to n's frame.
     uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
-        if (++visits_ > maxVisits_) throw TooLarge{};
+        if (++visits_ > maxVisits_ && !(cuts_ && visits_ <= cuts_->maxVisits())) throw TooLarge{};
         switch (g_.nodes[n].kind) {
             case NodeKind::Operator:
                 return buildOperator(n, s, pendingBase, edge);
@@ -803,11 +803,10 @@ std::unique_ptr<UnrolledInstance> UnrolledInstance::expand(const TraceScene& sce
     return x;
 }
 
-std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts,
-                                                              uint64_t maxVisits) {
+std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts) {
     if (scene.graph().axiom == kNone) return nullptr;
     auto x = std::make_unique<UnrolledInstance>();
-    Unroller builder(scene, *x, maxVisits, &cuts);
+    Unroller builder(scene, *x, cuts.maxVisits(), &cuts);
     try {
         builder.runTop();
     } catch (const TooLarge&) {
