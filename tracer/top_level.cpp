@@ -20,12 +20,12 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
 
     size_t instances() const { return index_.size(); }
 
-    // kMaxVisits, and kVisitsPerCopy more for each copy met, within the budget (at
-    // kBytesPerVisit): a scene of many copies (Sierpinski order 12's 4,096) is not refused
-    // for them, one without any (a terrain's upper levels) stops as soon as before.
+    // kMaxVisits, and kVisitsPerCopy more for each copy met, within the budget (one visit
+    // per kBudgetPerVisit bytes): a scene of many copies (Sierpinski order 12's 4,096) is not
+    // refused for them, one without any (a terrain's upper levels) stops as soon as before.
     uint64_t maxVisits() const override {
         return std::min<uint64_t>(kMaxVisits + kVisitsPerCopy * out_.copies_,
-                                  std::max<uint64_t>(kMaxVisits, maxBytes_ / kBytesPerVisit));
+                                  std::max<uint64_t>(kMaxVisits, maxBytes_ / kBudgetPerVisit));
     }
 
     const UnrolledInstance* cut(NodeId select, const PathState& s, uint32_t depth) override {

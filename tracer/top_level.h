@@ -42,12 +42,16 @@ namespace pcsg::tracer {
 class TopLevel {
   public:
     // Node visits above the cuts before the top level is refused: kMaxVisits, and
-    // kVisitsPerCopy more for each copy met so far, but no more than the budget's bytes
-    // at kBytesPerVisit (the top level's own arrays take ~60 bytes a visit). A terrain's
-    // dry runs, which find no cuts, stop at kMaxVisits (4 tries of ~2 M instructions).
+    // kVisitsPerCopy more for each copy met so far, but no more than one per
+    // kBudgetPerVisit bytes of the budget (32,768 in 16 MB: Sierpinski order 12's 4,096
+    // copies take ~20,000; the top level's arrays take ~60 bytes a visit, twice that
+    // while they grow, so that a try refused for its size, order 13 and up, holds ~4 MB
+    // at most: 65,536 gave order 13 a top level, and orders 14 to 16 5 to 8 MB more peak
+    // RSS for the tries). A terrain's dry runs, which find no cuts, stop at kMaxVisits
+    // (4 tries of ~2 M instructions).
     static constexpr uint64_t kMaxVisits = 1u << 13;
     static constexpr uint64_t kVisitsPerCopy = 16;
-    static constexpr uint64_t kBytesPerVisit = 64;
+    static constexpr uint64_t kBudgetPerVisit = 512;
 
     // The top level of the scene, cut where `cache` expands, or nullptr (refused, see
     // above). Throws RuntimeError when unrolling meets a run-time error.

@@ -77,7 +77,7 @@ class Unroller {
         double* root = pushFrame();
         initFrame(g_, root);
         const PathState s{root, kRootPath, 0, UnrolledInstance::kInherit};
-        const Lent lent(out_);
+        const Lent lent(out_, /*keep=*/false);
         finish(build(g_.axiom, s, 0, Affine::identity()));
     }
 
@@ -97,10 +97,13 @@ class Unroller {
 
     // The thread's BuildArrays lent to the expansion being built (when no other on this
     // thread has them), and taken back when it is done: the expansion's arrays are copied
-    // out at their final sizes, or, should the build throw, given up.
+    // out at their final sizes, or, should the build throw, given up. Unless `keep`, the
+    // thread's arrays are freed then (a top level: built once, and larger than the
+    // expansions, which would keep its size for good).
     class Lent {
       public:
-        explicit Lent(UnrolledInstance& x) : x_(x), b_(arrays()), mine_(!b_.lent) {
+        explicit Lent(UnrolledInstance& x, bool keep = true)
+            : x_(x), b_(arrays()), mine_(!b_.lent), keep_(keep) {
             if (!mine_) return;
             b_.lent = true;
             eachArray(b_, x_, [](auto& b, auto& x) {
@@ -114,10 +117,11 @@ class Unroller {
                 return;
             }
             const bool done = std::uncaught_exceptions() == 0;
-            eachArray(b_, x_, [done](auto& b, auto& x) {
+            eachArray(b_, x_, [done, keep = keep_](auto& b, auto& x) {
                 b.swap(x);
                 if (done) x.assign(b.begin(), b.end());
                 b.clear();
+                if (!keep) b.shrink_to_fit();
             });
             b_.lent = false;
         }
@@ -131,7 +135,7 @@ class Unroller {
         }
         UnrolledInstance& x_;
         BuildArrays& b_;
-        const bool mine_;
+        const bool mine_, keep_;
     };
 
     using Node = UnrolledInstance::Node;
