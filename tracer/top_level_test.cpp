@@ -121,7 +121,7 @@ TEST(TopLevel, CopiesBeyondTheVisitsOfAFewHundredAreNotRefused) {
     // top level takes more than kMaxVisits visits above them)
     InstanceBoxOptions small = eagerExpansion();
     small.maxUnrollWeight = 200;
-    const Result r = compareWithGraphWalk(testing::sierpinski(8), 3000, 1.0, 4u << 20, small);
+    const Result r = compareWithGraphWalk(testing::sierpinski(8), 3000, 1.0, 16u << 20, small);
     ASSERT_TRUE(r.built);
     EXPECT_GT(r.copies, TopLevel::kMaxVisits / 4);
     EXPECT_EQ(r.instances, 1u);
