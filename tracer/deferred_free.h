@@ -43,9 +43,10 @@ class DeferredFree {
     void unpin(Slot& s) { s.epoch.store(kIdle, std::memory_order_release); }
 
     // Hands over objects already taken out of the shared structure (`bytes` in all), then
-    // frees what no reader can hold any more.
-    template <class T>
-    void retire(std::vector<std::unique_ptr<T>>& objects, size_t bytes);
+    // frees what no reader can hold any more. `Owner`: std::unique_ptr, or std::shared_ptr
+    // (then an object lives on while another owner holds it).
+    template <class Owner>
+    void retire(std::vector<Owner>& objects, size_t bytes);
     // Frees what no reader can hold any more.
     void reclaim();
 
@@ -68,10 +69,10 @@ class DeferredFree {
     std::vector<Retired> retired_;
 };
 
-template <class T>
-void DeferredFree::retire(std::vector<std::unique_ptr<T>>& objects, size_t bytes) {
+template <class Owner>
+void DeferredFree::retire(std::vector<Owner>& objects, size_t bytes) {
     if (objects.empty()) return;
-    retireErased(std::make_shared<std::vector<std::unique_ptr<T>>>(std::move(objects)), bytes);
+    retireErased(std::make_shared<std::vector<Owner>>(std::move(objects)), bytes);
     objects.clear();
 }
 

@@ -1,6 +1,7 @@
 // The two-level structure: see top_level.h.
 #include "top_level.h"
 
+#include <algorithm>
 #include <unordered_map>
 
 #include "traversal.h"
@@ -8,9 +9,9 @@
 namespace pcsg::tracer {
 
 // Where expandTop stops: the expanded instances, one per (instance key, depth), shared by
-// their copies. A dry run only counts the copies and the instances (it refers every copy
-// to an empty instance), so that a scene whose instances are all unique is refused before
-// any is expanded.
+// their copies, and with the expansion cache where it has built them. A dry run only counts the
+// copies and the instances (it refers every copy to an empty instance), so that a scene whose
+// instances are all unique is refused before any is expanded.
 class TopLevel::Cuts final : public UnrolledInstance::Cuts {
   public:
     Cuts(const TraceScene& scene, const UnrollCache& cache, size_t maxBytes, TopLevel& out,
@@ -18,6 +19,14 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
         : scene_(scene), cache_(cache), maxBytes_(maxBytes), out_(out), dry_(dry) {}
 
     size_t instances() const { return index_.size(); }
+
+    // kMaxVisits, and kVisitsPerCopy more for each copy met, within the budget (one visit
+    // per kBudgetPerVisit bytes): a scene of many copies (Sierpinski order 12's 4,096) is not
+    // refused for them, one without any (a terrain's upper levels) stops as soon as before.
+    uint64_t maxVisits() const override {
+        return std::min<uint64_t>(kMaxVisits + kVisitsPerCopy * out_.copies_,
+                                  std::max<uint64_t>(kMaxVisits, maxBytes_ / kBudgetPerVisit));
+    }
 
     const UnrolledInstance* cut(NodeId select, const PathState& s, uint32_t depth) override {
         const InstanceBoxes& boxes = *scene_.instanceBoxes();
@@ -28,10 +37,13 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
         ++out_.copies_;
         const InstanceBoxes::Key k = boxes.keyOf(select, s.frame, s.path);
         const auto [it, added] = index_.try_emplace(Slot{k, depth}, kNone);
-        if (dry_) return &empty_;
+        if (dry_) {  // (as the real run refuses, so that unique copies stop it early)
+            const size_t n = index_.size();
+            if (n > 64 && 2 * n > out_.copies_) throw UnrolledInstance::Refused{};
+            return &empty_;
+        }
         if (!added) return it->second == kNone ? nullptr : out_.owned_[it->second].get();
-        auto x = UnrolledInstance::expand(scene_, select, depth, s.frame, s.path,
-                                          boxes.maxUnrollWeight());
+        std::shared_ptr<const UnrolledInstance> x = instance(k, select, depth, s);
         if (!x || x->bytes() > maxBytes_ / 8) return nullptr;  // (noted: expanded in place)
         if (depth + x->levels() > scene_.graph().scene.settings.maxDepth)
             throw UnrolledInstance::Refused{};  // (the walk raises the error)
@@ -45,6 +57,18 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
     }
 
   private:
+    // The cache's instance of key k (so that it exists once), or, where the cache has none
+    // built, one of the top level's own.
+    std::shared_ptr<const UnrolledInstance> instance(const InstanceBoxes::Key& k, NodeId select,
+                                                     uint32_t depth, const PathState& s) {
+        if (auto x = cache_.share(k)) {
+            ++out_.shared_;
+            return x;
+        }
+        return UnrolledInstance::expand(scene_, select, depth, s.frame, s.path,
+                                        scene_.instanceBoxes()->maxUnrollWeight());
+    }
+
     struct Slot {
         InstanceBoxes::Key key;
         uint32_t depth;
@@ -67,12 +91,12 @@ std::unique_ptr<TopLevel> TopLevel::build(const TraceScene& scene, const UnrollC
     if (!scene.instanceBoxes() || maxBytes == 0) return nullptr;
     auto t = std::make_unique<TopLevel>();
     Cuts dry(scene, cache, maxBytes, *t, true);
-    if (!UnrolledInstance::expandTop(scene, dry, kMaxVisits) || dry.instances() == 0 ||
+    if (!UnrolledInstance::expandTop(scene, dry) || dry.instances() == 0 ||
         2 * dry.instances() > t->copies_)
         return nullptr;
     t->copies_ = 0;
     Cuts cuts(scene, cache, maxBytes, *t, false);
-    t->top_ = UnrolledInstance::expandTop(scene, cuts, kMaxVisits);
+    t->top_ = UnrolledInstance::expandTop(scene, cuts);
     if (!t->top_ || t->top_->empty() || t->owned_.empty()) return nullptr;
     t->bytes_ += t->top_->bytes();
     if (t->bytes_ > maxBytes) return nullptr;

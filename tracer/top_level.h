@@ -7,7 +7,9 @@
 // copies' boxes in the top frame.
 //
 //  - One mechanism: the top level is an UnrolledInstance (expandTop) whose nodes of kind
-//    Instance refer to the expanded instances this class owns. Above the cuts it takes
+//    Instance refer to the expanded instances this class holds: the expansion cache's own
+//    where it has built them (UnrollCache::share: each exists once, and lives on here
+//    when the cache evicts it), else expanded here. Above the cuts it takes
 //    the graph walk's steps (semantics.h) in the same order, so a copy's ray is mapped by
 //    the same matrices, in the same order, as the walk maps it; a hit's path is the
 //    top level's path to the S-node followed by the instance's own; materials are
@@ -20,9 +22,9 @@
 //    above the cuts, a paint node whose pattern needs its frame, a level where the cache
 //    stopped expanding (a terrain's patches, each used by a few rays: every instance
 //    unique), more than half as many instances as copies, more than `maxBytes` in all
-//    (top and instances), more than kMaxVisits node visits above the cuts, an instance
-//    whose deepest S-node passes max_depth, or a run-time error (the walk raises it where
-//    a ray meets it).
+//    (top and instances), more node visits above the cuts than kMaxVisits and a few per
+//    copy met (see below), an instance whose deepest S-node passes max_depth, or a
+//    run-time error (the walk raises it where a ray meets it).
 //  - When it is built: by TraceScene::buildTopLevel, which a tracer calls once the
 //    expansion cache has seen a few thousand rays enter the scene (so that the cuts are
 //    known); per TraceScene, so per frame of a sequence. Immutable once built.
@@ -39,9 +41,17 @@ namespace pcsg::tracer {
 
 class TopLevel {
   public:
-    // Node visits above the cuts before the top level is refused (a few hundred copies; a
-    // terrain's dry runs, which find no cuts, stop there: 4 tries of ~2 M instructions).
+    // Node visits above the cuts before the top level is refused: kMaxVisits, and
+    // kVisitsPerCopy more for each copy met so far, but no more than one per
+    // kBudgetPerVisit bytes of the budget (32,768 in 16 MB: Sierpinski order 12's 4,096
+    // copies take ~20,000; the top level's arrays take ~60 bytes a visit, twice that
+    // while they grow, so that a try refused for its size, order 13 and up, holds ~4 MB
+    // at most: 65,536 gave order 13 a top level, and orders 14 to 16 5 to 8 MB more peak
+    // RSS for the tries). A terrain's dry runs, which find no cuts, stop at kMaxVisits
+    // (4 tries of ~2 M instructions).
     static constexpr uint64_t kMaxVisits = 1u << 13;
+    static constexpr uint64_t kVisitsPerCopy = 16;
+    static constexpr uint64_t kBudgetPerVisit = 512;
 
     // The top level of the scene, cut where `cache` expands, or nullptr (refused, see
     // above). Throws RuntimeError when unrolling meets a run-time error.
@@ -54,15 +64,20 @@ class TopLevel {
         return top_->first(r, tmin, tmax, hit, {kRootPath, 0, 0}, anyHit, s);
     }
 
-    size_t bytes() const { return bytes_; }  // the top level and the instances it owns
+    size_t bytes() const { return bytes_; }  // the top level and the instances it holds
     size_t copies() const { return copies_; }
     size_t instances() const { return owned_.size(); }
+    // Instances it holds that the expansion cache had built (and shares with it).
+    size_t sharedInstances() const { return shared_; }
+    const UnrolledInstance& instance(size_t i) const { return *owned_[i]; }
 
   private:
     class Cuts;
-    std::vector<std::unique_ptr<UnrolledInstance>> owned_;
+    // The instances the copies refer to: the expansion cache's where it had built them
+    // (which stay valid here when the cache evicts them), else the top level's own.
+    std::vector<std::shared_ptr<const UnrolledInstance>> owned_;
     std::unique_ptr<UnrolledInstance> top_;
-    size_t bytes_ = 0, copies_ = 0;
+    size_t bytes_ = 0, copies_ = 0, shared_ = 0;
 };
 
 }  // namespace pcsg::tracer

@@ -1,6 +1,7 @@
 // The two-level structure (top_level.h): for many random rays it finds the graph walk's
 // hits exactly (t, normal, instance path, material), shadow rays included; copies share
-// their instances; it is refused where the part above the cuts is not all unions.
+// their instances, with the expansion cache; it is refused where the part above the cuts is not all
+// unions.
 #include "top_level.h"
 
 #include <gtest/gtest.h>
@@ -61,14 +62,15 @@ struct Result {
 // every first hit and shadow ray with a scene that only walks the graph. `expansionBytes`:
 // the budget of the expansion cache (and of the top level).
 Result compareWithGraphWalk(const std::string& text, int n, double spread,
-                            size_t expansionBytes = 16u << 20) {
+                            size_t expansionBytes = 16u << 20,
+                            const InstanceBoxOptions& options = eagerExpansion()) {
     Result out;
     auto c = compile(text);
     if (!c->graph) return out;
     const Graph& g = *c->graph;
-    TraceScene plain(g, computeBounds(g), true, eagerExpansion());
+    TraceScene plain(g, computeBounds(g), true, options);
     plain.expansionBytes = 0;
-    TraceScene twoLevel(g, computeBounds(g), true, eagerExpansion());
+    TraceScene twoLevel(g, computeBounds(g), true, options);
     twoLevel.expansionBytes = expansionBytes;
     Tracer a(plain), b(twoLevel);
     std::mt19937_64 rng(11);
@@ -114,6 +116,18 @@ TEST(TopLevel, SierpinskiCopiesShareTheirInstanceAndHitTheWalksSurfaces) {
     EXPECT_GT(r.hits, 300u);
 }
 
+TEST(TopLevel, CopiesBeyondTheVisitsOfAFewHundredAreNotRefused) {
+    // (only small instances are expanded, those of a deep level: thousands of copies, whose
+    // top level takes more than kMaxVisits visits above them)
+    InstanceBoxOptions small = eagerExpansion();
+    small.maxUnrollWeight = 200;
+    const Result r = compareWithGraphWalk(testing::sierpinski(8), 3000, 1.0, 16u << 20, small);
+    ASSERT_TRUE(r.built);
+    EXPECT_GT(r.copies, TopLevel::kMaxVisits / 4);
+    EXPECT_EQ(r.instances, 1u);
+    EXPECT_GT(r.hits, 300u);
+}
+
 TEST(TopLevel, FlowersInheritTheirCopiesMaterialsAndHitTheWalksSurfaces) {
     const Result r = compareWithGraphWalk(kFlowers, 1500, 1.5);
     ASSERT_TRUE(r.built);
@@ -138,6 +152,58 @@ TEST(TopLevel, ADifferenceAboveTheInstancesFallsBackToTheWalk) {
     const Result r = compareWithGraphWalk(kCsgAbove, 1500, 1.0);
     EXPECT_FALSE(r.built);
     EXPECT_GT(r.hits, 300u);
+}
+
+// The first hits of rays from the origins o in the directions d through the top level alone.
+std::vector<Hit> hitsOf(const TopLevel& top, const std::vector<Vec3>& o,
+                        const std::vector<Vec3>& d) {
+    UnrolledInstance::Scratch scratch;
+    std::vector<Hit> hits(o.size());
+    for (size_t i = 0; i < o.size(); ++i) {
+        double tmax = 1e7;
+        top.first(LocalRay{o[i], d[i]}, 1e-4, tmax, hits[i], false, scratch);
+    }
+    return hits;
+}
+
+TEST(TopLevel, CopiesReferToTheCachesInstanceWhichLivesOnWithTheTopLevel) {
+    auto c = compile(testing::sierpinski(5));
+    ASSERT_TRUE(c->graph);
+    auto scene =
+        std::make_unique<TraceScene>(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
+    scene->expansionBytes = 256u << 10;  // (the cache expands a level below the top)
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<Vec3> o, d;
+    for (int i = 0; i < 2000; ++i) {
+        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
+        d.push_back(normalize(Vec3{u(rng), u(rng), u(rng) + 0.5} - o.back()));
+    }
+    {
+        Tracer warm(*scene);
+        SurfaceHit h;
+        for (int round = 0; round < 2; ++round)
+            for (size_t i = 0; i < o.size(); ++i) warm.firstHit(o[i], d[i], 1e-4, 1e7, h);
+    }
+    const auto one = TopLevel::build(*scene, scene->expansionCache(), scene->expansionBytes);
+    const auto two = TopLevel::build(*scene, scene->expansionCache(), scene->expansionBytes);
+    ASSERT_TRUE(one && two);
+    ASSERT_EQ(one->instances(), 1u);
+    EXPECT_EQ(one->sharedInstances(), 1u);
+    // Both top levels refer to the one object the cache built, not to copies of their own.
+    EXPECT_EQ(&one->instance(0), &two->instance(0));
+    const std::vector<Hit> before = hitsOf(*one, o, d);
+    scene.reset();  // the cache goes, and what it held (ASan: a use after free if freed)
+    const std::vector<Hit> after = hitsOf(*one, o, d);
+    size_t hits = 0;
+    for (size_t i = 0; i < o.size(); ++i) {
+        EXPECT_EQ(after[i].valid, before[i].valid) << "ray " << i;
+        if (!before[i].valid) continue;
+        ++hits;
+        EXPECT_EQ(after[i].t, before[i].t) << "ray " << i;
+        EXPECT_EQ(after[i].key, before[i].key) << "ray " << i;
+    }
+    EXPECT_GT(hits, 300u);
 }
 
 }  // namespace

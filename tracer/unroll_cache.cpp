@@ -37,9 +37,9 @@ constexpr size_t kMinBytesPerVisit = 32;
 
 struct UnrollCache::Entry {
     enum class State : uint8_t { Note, Building, Built, TooLarge };
-    State state = State::Note;                   // (written under the shard's write lock)
-    std::atomic<bool> referenced{false};         // used since the eviction hand passed
-    std::unique_ptr<UnrolledInstance> instance;  // Built
+    State state = State::Note;                         // (written under the shard's write lock)
+    std::atomic<bool> referenced{false};               // used since the eviction hand passed
+    std::shared_ptr<const UnrolledInstance> instance;  // Built (shared with a top level)
     size_t bytes = kNoteBytes;
     bool evicted = false;  // a note left by an instance that was built and evicted
 };
@@ -87,7 +87,7 @@ size_t UnrollCache::yieldIndex(NodeId select, uint32_t depth) const {
 // construction) go to the back of the queue; the others leave, until the cache fits.
 // One evicting thread at a time (the queue's mutex, then a shard's lock).
 void UnrollCache::evict() {
-    std::vector<std::unique_ptr<UnrolledInstance>> out;
+    std::vector<std::shared_ptr<const UnrolledInstance>> out;
     size_t freed = 0;
     {
         std::lock_guard<std::mutex> hand(queueMutex_);
@@ -159,6 +159,14 @@ const UnrolledInstance* UnrollCache::Reader::built(const InstanceBoxes::Key& key
         e.referenced.store(true, std::memory_order_relaxed);
     used(y);
     return e.instance.get();
+}
+
+std::shared_ptr<const UnrolledInstance> UnrollCache::share(const InstanceBoxes::Key& key) const {
+    Shard& s = shardOf(key);
+    tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
+    const auto it = s.map.find(key);
+    if (it == s.map.end() || it->second.state != Entry::State::Built) return nullptr;
+    return it->second.instance;
 }
 
 const UnrolledInstance* UnrollCache::Reader::get(NodeId select, uint32_t depth, const double* frame,

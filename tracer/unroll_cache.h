@@ -6,7 +6,9 @@
 //    lock of one shard of 64); each thread uses the cache through a Reader of its own.
 //  - Lifetime: instances are immutable once built. An instance evicted while another
 //    thread traces it is freed only when that thread has unpinned (deferred_free.h): a
-//    tracer's Reader is pinned from its first look-up in a ray to the ray's end.
+//    tracer's Reader is pinned from its first look-up in a ray to the ray's end. The
+//    top level (top_level.h) shares instances with the cache (share()): one it holds
+//    lives on after the cache evicts it, and is freed with the top level.
 //  - Notes: the first meeting of an instance, by any thread, leaves a note; the second,
 //    by any thread, expands it. While one thread expands an instance it is marked "in
 //    construction", and the others walk the graph below it meanwhile, not wait.
@@ -74,6 +76,11 @@ class UnrollCache {
         bool off = false;      // expansion stopped there
     };
     Level level(NodeId select, uint32_t depth) const;
+
+    // The instance stored under `key` if it is built (else nullptr), for a holder that keeps
+    // it beyond a Pin scope (the top level): it stays valid while the holder holds it,
+    // whatever the cache evicts meanwhile. Not counted as a use.
+    std::shared_ptr<const UnrolledInstance> share(const InstanceBoxes::Key& key) const;
 
   private:
     struct Entry;

@@ -77,7 +77,7 @@ class Unroller {
         double* root = pushFrame();
         initFrame(g_, root);
         const PathState s{root, kRootPath, 0, UnrolledInstance::kInherit};
-        const Lent lent(out_);
+        const Lent lent(out_, /*keep=*/false);
         finish(build(g_.axiom, s, 0, Affine::identity()));
     }
 
@@ -97,10 +97,13 @@ class Unroller {
 
     // The thread's BuildArrays lent to the expansion being built (when no other on this
     // thread has them), and taken back when it is done: the expansion's arrays are copied
-    // out at their final sizes, or, should the build throw, given up.
+    // out at their final sizes, or, should the build throw, given up. Unless `keep`, the
+    // thread's arrays are freed then (a top level: built once, and larger than the
+    // expansions, which would keep its size for good).
     class Lent {
       public:
-        explicit Lent(UnrolledInstance& x) : x_(x), b_(arrays()), mine_(!b_.lent) {
+        explicit Lent(UnrolledInstance& x, bool keep = true)
+            : x_(x), b_(arrays()), mine_(!b_.lent), keep_(keep) {
             if (!mine_) return;
             b_.lent = true;
             eachArray(b_, x_, [](auto& b, auto& x) {
@@ -114,10 +117,11 @@ class Unroller {
                 return;
             }
             const bool done = std::uncaught_exceptions() == 0;
-            eachArray(b_, x_, [done](auto& b, auto& x) {
+            eachArray(b_, x_, [done, keep = keep_](auto& b, auto& x) {
                 b.swap(x);
                 if (done) x.assign(b.begin(), b.end());
                 b.clear();
+                if (!keep) b.shrink_to_fit();
             });
             b_.lent = false;
         }
@@ -131,7 +135,7 @@ class Unroller {
         }
         UnrolledInstance& x_;
         BuildArrays& b_;
-        const bool mine_;
+        const bool mine_, keep_;
     };
 
     using Node = UnrolledInstance::Node;
@@ -153,7 +157,7 @@ class Unroller {
     // nothing. The inverse matrices in pending_[pendingBase..] and the forward map `edge`
     // lead from the frame of the last operator above (or the S-node) to n's frame.
     uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
-        if (++visits_ > maxVisits_) throw TooLarge{};
+        if (++visits_ > maxVisits_ && !(cuts_ && visits_ <= cuts_->maxVisits())) throw TooLarge{};
         switch (g_.nodes[n].kind) {
             case NodeKind::Operator:
                 return buildOperator(n, s, pendingBase, edge);
@@ -803,11 +807,10 @@ std::unique_ptr<UnrolledInstance> UnrolledInstance::expand(const TraceScene& sce
     return x;
 }
 
-std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts,
-                                                              uint64_t maxVisits) {
+std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts) {
     if (scene.graph().axiom == kNone) return nullptr;
     auto x = std::make_unique<UnrolledInstance>();
-    Unroller builder(scene, *x, maxVisits, &cuts);
+    Unroller builder(scene, *x, cuts.maxVisits(), &cuts);
     try {
         builder.runTop();
     } catch (const TooLarge&) {

@@ -132,21 +132,23 @@ class UnrolledInstance {
 
     // Where an expansion of the whole graph (expandTop) stops: the expanded instance to
     // refer to for the S-node `select` entered in state `s` at `depth` (it must outlive the
-    // expansion), nullptr to expand the S-node in place; throws Refused to give up.
+    // expansion), nullptr to expand the S-node in place; throws Refused to give up. And the
+    // node visits the expansion may take, asked again each time it passes them (so that
+    // the cuts met so far may raise them).
     struct Refused {};
     class Cuts {
       public:
         virtual const UnrolledInstance* cut(NodeId select, const PathState& s, uint32_t depth) = 0;
+        virtual uint64_t maxVisits() const = 0;
 
       protected:
         ~Cuts() = default;
     };
     // The whole graph from the axiom, cut where `cuts` says: nullptr when it takes more
-    // than `maxVisits` node visits, meets an operator other than a union, a paint node
-    // whose pattern needs the node's frame, or is refused. Throws RuntimeError when
+    // than `cuts.maxVisits()` node visits, meets an operator other than a union, a paint
+    // node whose pattern needs the node's frame, or is refused. Throws RuntimeError when
     // unrolling meets a run-time error. Traced with first() and Use{kRootPath, 0, 0}.
-    static std::unique_ptr<UnrolledInstance> expandTop(const TraceScene& scene, Cuts& cuts,
-                                                       uint64_t maxVisits);
+    static std::unique_ptr<UnrolledInstance> expandTop(const TraceScene& scene, Cuts& cuts);
 
     const Box& box() const { return nodes_[root_].box; }
     bool empty() const { return root_ == kNone; }
