@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <random>
 #include <thread>
 
@@ -196,6 +197,15 @@ TEST(ExpandedInstances, BoxesRoundOutwardsToFloats) {
         if (std::isfinite(x) && std::isfinite(hi)) {
             EXPECT_LT(static_cast<double>(std::nextafter(hi, -INFINITY)), x) << x;
         }
+    }
+    // the step down is libm's nextafter, bit for bit (zeros and subnormals included)
+    const float kMax = std::numeric_limits<float>::max();
+    for (double x : xs) {
+        const float f = static_cast<float>(x);
+        if (!std::isfinite(f) || f <= -kMax) continue;
+        EXPECT_EQ(std::bit_cast<uint32_t>(floatStepDown(f)),
+                  std::bit_cast<uint32_t>(std::nextafter(f, -kMax)))
+            << f;
     }
     EXPECT_TRUE(std::isnan(floatBelow(std::nan(""))));
     EXPECT_TRUE(std::isnan(floatAbove(std::nan(""))));
