@@ -43,11 +43,11 @@ void Semantics::transformStep(NodeId n, const PathState& s, StepScratch& scratch
         scratch.memo->transform(n, EvalState{s.frame, s.path}, m.forward, m.inverse);
     } else {
         m.forward = transformMatrix(g_, n, EvalState{s.frame, s.path});
-        m.inverse = m.forward.inverse();
+        if (!scratch.forwardOnly) m.inverse = m.forward.inverse();
     }
     step.child = g_.child(n);
     step.forward = &m.forward;
-    step.inverse = &m.inverse;
+    step.inverse = scratch.forwardOnly && !scratch.memo ? nullptr : &m.inverse;
 }
 
 Affine Semantics::forwardThrough(const Affine& outer, NodeId n, const Step& st) const {

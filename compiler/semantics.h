@@ -50,14 +50,16 @@ struct Step {
     PathState state;                  // the state there
     uint32_t rule = kNone;            // S-nodes: the rule taken (0-based)
     const Affine* forward = nullptr;  // T-nodes: maps `child`'s frame into this node's
-    const Affine* inverse = nullptr;  // T-nodes: the inverse of `forward`
+    const Affine* inverse = nullptr;  // T-nodes: the inverse of `forward` (see forwardOnly)
 };
 
 // Storage a walker lends to enter(): the new frame of a C-node (Graph::slotCount() values,
 // not the incoming frame) and the matrices of a T-node that depends on parameters (made
 // only then: the walk takes a step per node of every ray).
 // A walker may also lend its StepMemo (step_memo.h), which remembers the results of C-
-// and T-steps by what they read.
+// and T-steps by what they read. A walker that maps only forwards (walk.h: world matrices,
+// never rays) sets forwardOnly: a T-step without a memo then leaves `inverse` null instead
+// of inverting a matrix nobody reads.
 struct StepScratch {
     struct Matrices {
         Affine forward, inverse;
@@ -79,6 +81,7 @@ struct StepScratch {
     double* frame = nullptr;
     MatrixRoom matrices;
     StepMemo* memo = nullptr;
+    bool forwardOnly = false;
 };
 
 class Semantics {

@@ -165,6 +165,7 @@ class Walker {
         const NodeKind kind = g_.nodes[e.node].kind;
         if (kind == NodeKind::Select && memoised(e)) return;
         StepScratch scratch;
+        scratch.forwardOnly = true;  // (world matrices only: no T-node's inverse is read)
         size_t frame = e.frame;
         if (kind == NodeKind::Calc) {
             frame = arena_.size();

@@ -3,10 +3,22 @@
 // that the double box lets through.
 #pragma once
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace pcsg::tracer {
+
+// The float just below f (finite, above -FLT_MAX): std::nextafter(f, -FLT_MAX), one step of
+// the bits instead of a call into libm (a terrain patch's hierarchy rounds some 1,500
+// bounds).
+inline float floatStepDown(float f) {
+    const uint32_t bits = std::bit_cast<uint32_t>(f);
+    if (f > 0) return std::bit_cast<float>(bits - 1);
+    if (f == 0) return -std::numeric_limits<float>::denorm_min();
+    return std::bit_cast<float>(bits + 1);
+}
 
 // The largest float at most x (NaN stays NaN; below -FLT_MAX: -infinity).
 inline float floatBelow(double x) {
@@ -14,7 +26,7 @@ inline float floatBelow(double x) {
     if (x > kMax) return kMax;  // (also +infinity: the largest float is at most it)
     if (x < -kMax) return -std::numeric_limits<float>::infinity();
     float f = static_cast<float>(x);
-    if (static_cast<double>(f) > x) f = std::nextafter(f, -kMax);
+    if (static_cast<double>(f) > x) f = floatStepDown(f);
     return f;
 }
 

@@ -2,6 +2,7 @@
 #include "unrolled_instances.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -312,14 +313,25 @@ class Unroller {
         Box box;
     };
 
+    // A part of a union's hierarchy as its derivation nests it: an operand (kLeaf, entered
+    // through `link`) or a node of binary_, with its box and the binary levels below it
+    // (child kNone: nothing).
+    struct Part {
+        uint32_t child = kNone, link = kNone;
+        Box box;
+        uint32_t height = 0;
+    };
+
     // The operands of union u and of the unions nested in it, each entered from u's frame
     // through the chain of matrices of the unions on its way (`link`, a path in the tree
     // links_ whose branches the operands share), then its own, with its box mapped into u's
     // frame. `link` (`length` matrices) leads from the outermost union into u's frame
-    // (kNone: u is outermost) and `toU` maps points the other way.
-    void collect(uint32_t u, const Affine& toU, uint32_t link, uint32_t length,
+    // (kNone: u is outermost) and `toU` maps points the other way. Returns the hierarchy
+    // the derivation gives them (in binary_): each nested union's parts paired up.
+    Part collect(uint32_t u, const Affine& toU, uint32_t link, uint32_t length,
                  std::vector<Item>& items) {
         const Node un = out_.nodes_[u];
+        const size_t base = parts_.size();
         for (uint32_t i = 0; i < un.count; ++i) {
             const uint32_t c = out_.children_[un.first + i];
             const Node& child = out_.nodes_[c];
@@ -331,13 +343,36 @@ class Unroller {
                     l = linkTo(l, out_.matrixRefs_[child.firstMatrix + k]);
                     to = to * out_.matrices_[out_.matrixRefs_[child.firstMatrix + k]].inverse();
                 }
-                collect(c, to, l, length + child.matrices, items);
+                const Part inner = collect(c, to, l, length + child.matrices, items);
+                if (inner.child != kNone) parts_.push_back(inner);
                 continue;
             }
             const Box box =
                 link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
             items.push_back({c, link, box});
+            parts_.push_back({c | UnrolledInstance::kLeaf, link, box, 0});
         }
+        const Part whole = pairUp(base, parts_.size());
+        parts_.resize(base);
+        return whole;
+    }
+
+    // The binary hierarchy over parts_[begin, end) in their order, halved at the middle.
+    Part pairUp(size_t begin, size_t end) {
+        if (begin == end) return Part{};
+        if (end - begin == 1) return parts_[begin];
+        const size_t mid = begin + (end - begin) / 2;
+        const Part halves[2] = {pairUp(begin, mid), pairUp(mid, end)};
+        Binary b;
+        for (int c = 0; c < 2; ++c) {
+            b.box[c] = halves[c].box;
+            b.child[c] = halves[c].child;
+            b.link[c] = halves[c].link;
+        }
+        binary_.push_back(b);
+        const uint32_t height = 1 + std::max(halves[0].height, halves[1].height);
+        return {static_cast<uint32_t>(binary_.size() - 1), kNone,
+                unite(halves[0].box, halves[1].box), height};
     }
 
     // The link that applies out_.matrices_[matrix] after the chain `parent`.
@@ -350,16 +385,25 @@ class Unroller {
     }
 
     // Builds the BVHs of the unions that first hits reach through n: one operand per leaf.
+    // Where the derivation nests the operands about as deep as median splits would (a
+    // terrain patch's four sub-triangles per level), its nesting is the hierarchy, built
+    // without sorting; otherwise (a flower's chain of petals) median splits make it.
     void hierarchy(uint32_t n) {
         if (!isUnion(out_.nodes_[n])) return;
         std::vector<Item> items;
-        collect(n, Affine::identity(), kNone, 0, items);
-        for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
-        if (items.size() <= kFewItems) return;                // the union's own operands will do
         binary_.clear();
-        const uint32_t root = split(items, 0, items.size());
-        out_.nodes_[n].bvh = collapse(root);
-        out_.bvhLeaves_ += static_cast<uint32_t>(items.size());
+        const Part derived = collect(n, Affine::identity(), kNone, 0, items);
+        if (items.size() > kFewItems) {  // (else the union's own operands will do)
+            const uint32_t balanced = std::bit_width(items.size() - 1) + 1;
+            uint32_t root = derived.child;
+            if (derived.height > balanced) {
+                binary_.clear();
+                root = split(items, 0, items.size());
+            }
+            out_.nodes_[n].bvh = collapse(root);
+            out_.bvhLeaves_ += static_cast<uint32_t>(items.size());
+        }
+        for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
     }
 
     // A node of the binary hierarchy that collapse() turns into four-wide nodes: child c
@@ -495,6 +539,7 @@ class Unroller {
     std::vector<uint32_t> kids_;  // operands of the operators being built
     FlatIndex linkIndex_;         // linkTo()'s links by (parent, matrix)
     std::vector<Binary> binary_;  // the hierarchy being built
+    std::vector<Part> parts_;     // collect()'s parts of the unions being collected
 };
 
 // ---------------------------------------------------------------------------------------
@@ -506,6 +551,16 @@ size_t UnrolledInstance::bytes() const {
            matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) +
            choices_.capacity() * sizeof(uint32_t) + bvh_.capacity() * sizeof(BvhNode) +
            links_.capacity() * sizeof(Link) + instances_.capacity() * sizeof(Reference);
+}
+
+std::vector<std::vector<uint32_t>> UnrolledInstance::bvhLeafGroups() const {
+    std::vector<std::vector<uint32_t>> groups;
+    for (const BvhNode& b : bvh_) {
+        std::vector<uint32_t>& leaves = groups.emplace_back();
+        for (const uint32_t c : b.child)
+            if (c != kNone && (c & kLeaf)) leaves.push_back(c & ~kLeaf);
+    }
+    return groups;
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
@@ -706,7 +761,8 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
         uint32_t child, link;
         double t0;
     };
-    // Deeper than any hierarchy of median splits (four entries per level at most).
+    // Deeper than any hierarchy of median splits, or of a derivation's nesting (hierarchy():
+    // at most one level deeper), with four entries per level at most.
     constexpr int kStack = 4 * 32 + 4;
     Pending stack[kStack];
     int top = 0;

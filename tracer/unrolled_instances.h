@@ -158,6 +158,10 @@ class UnrolledInstance {
     size_t bytes() const;
     // The nodes of the first-hit hierarchies, leaves included.
     size_t bvhNodes() const { return bvh_.size() + bvhLeaves_; }
+    // The operands each node of the first-hit hierarchies holds directly (their indices in
+    // the instance's nodes, in the order of the node's slots), node by node: which the
+    // hierarchy groups together (tests).
+    std::vector<std::vector<uint32_t>> bvhLeafGroups() const;
 
   private:
     friend class Unroller;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <random>
 #include <thread>
 
@@ -197,6 +198,15 @@ TEST(ExpandedInstances, BoxesRoundOutwardsToFloats) {
             EXPECT_LT(static_cast<double>(std::nextafter(hi, -INFINITY)), x) << x;
         }
     }
+    // the step down is libm's nextafter, bit for bit (zeros and subnormals included)
+    const float kMax = std::numeric_limits<float>::max();
+    for (double x : xs) {
+        const float f = static_cast<float>(x);
+        if (!std::isfinite(f) || f <= -kMax) continue;
+        EXPECT_EQ(std::bit_cast<uint32_t>(floatStepDown(f)),
+                  std::bit_cast<uint32_t>(std::nextafter(f, -kMax)))
+            << f;
+    }
     EXPECT_TRUE(std::isnan(floatBelow(std::nan(""))));
     EXPECT_TRUE(std::isnan(floatAbove(std::nan(""))));
 }
@@ -288,6 +298,58 @@ TEST(ExpandedInstances, AnExpansionsArraysAreItsOwnWhateverTheThreadBuiltBefore)
     ASSERT_TRUE(again);
     EXPECT_EQ(again->bytes(), fresh->bytes());
     EXPECT_EQ(hitOf(*again), hitOf(*fresh));
+}
+
+// Sixteen spheres in a row, x = a + 4b: the derivation puts a's four (b = 0..3) in one
+// union, four nested unions deep (balanced), or, as a chain of unions, one after the
+// other (x = 5k mod 16 for the k-th), so that spatial neighbours are never siblings.
+const char* kNestedRow = R"(
+{n = 2; x = 0; s = 1} T
+T if(n > 0, 2, 1)
+1: T -> move(x, 0, 0) uscale(0.1) sphere
+2: T -> {n = n-1; s = s*4} ({x = x} T ∪ {x = x + s/4} T ∪ {x = x + s/2} T ∪ {x = x + 3*s/4} T)
+)";
+const char* kChainRow = R"(
+{k = 0} C
+C if(k < 15, 2, 1)
+1: C -> move(mod(k*5, 16), 0, 0) uscale(0.1) sphere
+2: C -> move(mod(k*5, 16), 0, 0) uscale(0.1) sphere ∪ {k = k+1} C
+)";
+
+// The widest spread of instance node indices among the operands of one hierarchy node
+// (siblings in the derivation are built one after the other: a spread of 3 for four).
+uint32_t widestGroup(const char* text) {
+    auto c = compile(text);
+    EXPECT_TRUE(c->graph);
+    if (!c->graph) return 0;
+    const Graph& g = *c->graph;
+    TraceScene scene(g, computeBounds(g), true, eagerExpansion());
+    auto [select, frame] = testing::axiomInstance(g);
+    const auto x = UnrolledInstance::expand(scene, select, 1, frame.data(), kRootPath, 1u << 20);
+    EXPECT_TRUE(x);
+    if (!x) return 0;
+    uint32_t widest = 0, leaves = 0;
+    for (const std::vector<uint32_t>& group : x->bvhLeafGroups()) {
+        leaves += static_cast<uint32_t>(group.size());
+        if (group.empty()) continue;
+        const auto [lo, hi] = std::minmax_element(group.begin(), group.end());
+        widest = std::max(widest, *hi - *lo);
+    }
+    EXPECT_EQ(leaves, 16u);
+    return widest;
+}
+
+// A balanced derivation is the hierarchy itself (no sorting: siblings stay together even
+// where they lie far apart); a chain gets median splits (spatial neighbours together).
+TEST(ExpandedInstances, ABalancedDerivationIsTheHierarchyAndAChainIsSplit) {
+    EXPECT_EQ(widestGroup(kNestedRow), 3u);
+    EXPECT_GT(widestGroup(kChainRow), 3u);
+    Rays r;
+    for (int i = 0; i < 64; ++i) {
+        r.o.push_back({i * 0.25 + 0.02, -6, 0.03});
+        r.d.push_back(normalize(Vec3{0.01 * (i % 3), 1, 0.002 * (i % 5)}));
+    }
+    EXPECT_GT(compareWithGraphWalk(kNestedRow, r, 15), 0u);
 }
 
 }  // namespace

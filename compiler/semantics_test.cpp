@@ -1,0 +1,66 @@
+// Semantics::enter: a forward-only T-step gives the walker's matrix and no inverse.
+#include "semantics.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "compile_test_util.h"
+#include "step_memo.h"
+
+namespace pcsg {
+namespace {
+
+using testing::compileUnfolded;
+
+bool sameAffine(const Affine& a, const Affine& b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// T-nodes whose matrices depend on parameters (a and b), one constant chain (scale, move).
+constexpr const char* kScene = R"(
+{a = 2; b = 3} S
+S 1
+1: S -> rotx(a*30) uscale(1 + b/10) sphere ∪ move(a, b, 1) scale(1, 2, 3) move(0, 1, 0) cube
+)";
+
+// Every T-step of the scene taken forward-only and in full, with and without a memo.
+TEST(Semantics, AForwardOnlyStepSkipsTheInverseUnlessAMemoHasIt) {
+    auto c = compileUnfolded(kScene);  // (folded, a and b would be constants)
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    const Semantics sem(g);
+    const StepMemoPlan plan(g);
+    StepMemo memo(g, plan);
+    std::vector<double> frame(g.slotCount(), 0.0);
+    for (size_t k = 0; k < g.slotCount(); ++k) frame[k] = g.slotNames[k] == "a" ? 2.0 : 3.0;
+    const PathState s{frame.data(), kRootPath, 1, 0};
+    int computed = 0, fused = 0;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        if (g.nodes[n].kind != NodeKind::Transform) continue;
+        SCOPED_TRACE(::testing::Message() << "node " << n);
+        StepScratch full, forward, remembered;
+        forward.forwardOnly = remembered.forwardOnly = true;
+        remembered.memo = &memo;
+        const Step a = sem.enter(n, s, full), b = sem.enter(n, s, forward),
+                   m = sem.enter(n, s, remembered);
+        ASSERT_TRUE(a.forward && a.inverse && b.forward && m.forward && m.inverse);
+        EXPECT_TRUE(sameAffine(*a.forward, *b.forward));
+        EXPECT_TRUE(sameAffine(*a.forward, *m.forward));
+        EXPECT_TRUE(sameAffine(*a.inverse, *m.inverse));
+        EXPECT_EQ(a.child, b.child);
+        if (g.transforms[g.nodes[n].payload].constant) {
+            ++fused;  // a fused chain's inverse is computed once, up front: it stays
+            EXPECT_TRUE(b.inverse && sameAffine(*a.inverse, *b.inverse));
+        } else {
+            ++computed;
+            EXPECT_TRUE(sameAffine(*a.inverse, a.forward->inverse()));
+            EXPECT_EQ(b.inverse, nullptr);
+        }
+    }
+    EXPECT_EQ(computed, 3);
+    EXPECT_EQ(fused, 2);
+}
+
+}  // namespace
+}  // namespace pcsg
