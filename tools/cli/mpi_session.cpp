@@ -1,9 +1,13 @@
 #include "mpi_session.h"
 
 #include <dlfcn.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <stdexcept>
 
 #include "child_process.h"
@@ -32,6 +36,17 @@ int launcherRank() {
     for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
         if (const int r = envInt(name, -1); r >= 0) return r;
     return 0;
+}
+
+int execDynamicTwin(char** argv) {
+    const std::filesystem::path twin =
+        std::filesystem::path(selfExecutable()).parent_path() / "pcsg-dynamic";
+    execv(twin.c_str(), argv);
+    if (launcherRank() == 0)
+        std::cerr << "pcsg: cannot run " << twin.string()
+                  << ", which a static pcsg needs under mpirun or srun: " << std::strerror(errno)
+                  << "\n";
+    return 2;
 }
 
 std::unique_ptr<MpiSession> MpiSession::start(std::string& error) {

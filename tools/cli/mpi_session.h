@@ -22,6 +22,12 @@ bool launchedAsRanks();
 // This process's rank as the launcher's environment gives it (0 when it does not).
 int launcherRank();
 
+// A statically linked pcsg cannot load pcsg-mpi.so (Open MPI's libraries need the shared
+// glibc and its dynamic loader), so under a launcher it replaces itself (exec, the same
+// process for the launcher) with pcsg-dynamic, the same program linked against the shared
+// glibc, from beside it. Returns only when that fails, with exit status 2 and a message.
+int execDynamicTwin(char** argv);
+
 struct MpiMessage {
     int source = 0, tag = 0;
     std::vector<std::byte> bytes;

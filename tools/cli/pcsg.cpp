@@ -7,6 +7,9 @@
 #include "process_memory.h"
 
 int main(int argc, char** argv) {
+#ifdef PCSG_STATIC
+    if (pcsg::tools::launchedAsRanks()) return pcsg::tools::execDynamicTwin(argv);
+#endif
     pcsg::tools::fixMallocThresholds();
     CLI::App app{
         "pcsg: a scene compiler, ray tracer and verifier for recursive natural objects.\n"
