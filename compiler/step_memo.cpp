@@ -133,12 +133,29 @@ StepMemoPlan::StepMemoPlan(const Graph& g, const FixedSlots* fixed) : nodes_(g.n
     }
 }
 
+namespace {
+
+// The most bytes a thread's table takes: 2^entriesLog2 entries, halved until they fit. A
+// Sierpinski tetrahedron's 32-byte entries keep their 4,096 (128 KB); the growing tree's
+// 240-byte ones (a T-node's two matrices) get 1,024, not 4,096 (0.98 MB a thread, in every
+// frame of a sequence): its 48 frames at 640x480 on two threads 18.3 -> 16.7 MB of peak
+// RSS (docs/benchmarks.md, branch static).
+constexpr size_t kMaxTableBytes = size_t{256} << 10;
+
+uint32_t entriesLog2Within(size_t stride, uint32_t entriesLog2) {
+    while (entriesLog2 > 0 && (stride * sizeof(uint64_t) << entriesLog2) > kMaxTableBytes)
+        --entriesLog2;
+    return entriesLog2;
+}
+
+}  // namespace
+
 StepMemo::StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2)
     : g_(g),
       plan_(plan),
       stride_(kKey + plan.maxReads() + plan.maxWrites()),
-      table_(stride_ << entriesLog2),
-      mask_((1u << entriesLog2) - 1) {
+      table_(stride_ << entriesLog2Within(stride_, entriesLog2)),
+      mask_((1u << entriesLog2Within(stride_, entriesLog2)) - 1) {
     for (size_t i = 0; i < table_.size(); i += stride_) table_[i] = kNone;
 }
 

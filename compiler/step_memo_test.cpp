@@ -169,6 +169,11 @@ S if(c > 0, 2, 1)
     EXPECT_EQ(full.maxWrites(), 24u);
     EXPECT_GE(full.maxReads(), 2u);
     EXPECT_LT(full.maxReads(), StepMemoPlan::kMaxReads);
+    // Its entries are over 200 bytes: 1,024 of them (a table of at most 256 KB), not 4,096.
+    const size_t entryBytes = (2 + full.maxReads() + full.maxWrites()) * sizeof(uint64_t);
+    const StepMemo large(*k->graph, full, 12);
+    EXPECT_EQ(large.bytes(), 1024u * entryBytes);
+    EXPECT_EQ(StepMemo(*k->graph, full, 9).bytes(), 512u * entryBytes);
 }
 
 }  // namespace
