@@ -369,10 +369,14 @@ class TileRender {
     // from a 4-neighbour's by the threshold or more. Reads pass 1's centres; encodes them
     // only where a neighbour is not near (NearColours), which most pixels are not.
     bool differsFromNeighbour(Worker& wk, uint64_t pass, int x, int y) const {
-        const float* p = pixelAt(x, y);
+        const int r = (y - halo_.y0) % windowRows_;  // (one division for the three rows)
+        const ptrdiff_t row = static_cast<ptrdiff_t>(halo_.width()) * 3;
+        const float* p = rgb_.data() + r * row + (x - halo_.x0) * 3;
+        const float* up = r > 0 ? p - row : p + (windowRows_ - 1) * row;
+        const float* down = r + 1 < windowRows_ ? p + row : p - (windowRows_ - 1) * row;
         // (a neighbour outside the image is the pixel itself, which is near)
         if (near_(p, x > 0 ? p - 3 : p) && near_(p, x + 1 < w_ ? p + 3 : p) &&
-            near_(p, y > 0 ? pixelAt(x, y - 1) : p) && near_(p, y + 1 < h_ ? pixelAt(x, y + 1) : p))
+            near_(p, y > 0 ? up : p) && near_(p, y + 1 < h_ ? down : p))
             return false;
         const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
         const double* encoded = encodedTile(wk, pass, x, y);
