@@ -16,11 +16,14 @@ fi
 helper=$1 pcsg=$2 scene=$3
 unwanted='lib(stdc\+\+|gcc_s|tbb|fmt|png|z)\.so'
 
-if ! ldd "$helper" | grep -Eq "$unwanted"; then
+# (ldd's list read whole first: grep -q stops at the first match, and under pipefail the
+# SIGPIPE that ldd then gets failed this check in about half the runs)
+helperLibraries=$(ldd "$helper")
+if ! grep -Eq "$unwanted" <<<"$helperLibraries"; then
     echo "FAIL: $helper loads none of $unwanted: this check cannot see them" >&2
     exit 1
 fi
-echo "ok: $helper loads $(ldd "$helper" | grep -Eo "$unwanted" | sort -u | tr '\n' ' ')"
+echo "ok: $helper loads $(grep -Eo "$unwanted" <<<"$helperLibraries" | sort -u | tr '\n' ' ')"
 
 failed=0
 if found=$(ldd "$pcsg" | grep -E "$unwanted"); then
