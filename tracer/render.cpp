@@ -136,7 +136,8 @@ class TileRender {
     static constexpr int kDecide = 0, kEmit = 3;
     // The rows of the image kept at once (the window): those of the band in pass 1, of the
     // two before it (being decided and supersampled), of the one before them (being handed
-    // over) and the border rows above and below.
+    // over) and the border rows above and below. (65 are in use at most: the last band's
+    // border row below is written in the step that hands over the band 65 rows above it.)
     static constexpr int kWindowRows = 4 * kTile + 2;
 
     static int tileCount(const Region& r) {
