@@ -94,7 +94,7 @@ using Workers = std::vector<std::unique_ptr<Worker>>;
 class TileRender {
   public:
     TileRender(const TraceScene& scene, const PinholeCamera& camera, const RenderOptions& opt,
-               Workers& workers, const Region& region)
+               Workers& workers, const Region& region, const RowSink& sink)
         : scene_(scene),
           camera_(camera),
           opt_(opt),
@@ -107,84 +107,85 @@ class TileRender {
                                  : region),
           totalWork_(opt.adaptive > 0 ? bandCount() * (tilesAcross(halo_) + tilesAcross(region_))
                                       : tileCount(halo_)),
-          near_(opt.adaptive) {
-        rgb_.assign(halo_.pixels() * 3, 0.0f);
+          near_(opt.adaptive),
+          sink_(sink),
+          windowRows_(std::min(halo_.height(), kWindowRows)) {
+        rgb_.assign(static_cast<size_t>(windowRows_) * halo_.width() * 3, 0.0f);
+        if (opt.adaptive <= 0) return;
+        const size_t width = region_.width();
+        differs_.assign(static_cast<size_t>(std::min(region_.height(), 2 * kTile)) * width, 0);
+        band2_.assign(static_cast<size_t>(std::min(region_.height(), kTile)) * width * 3, 0.0f);
     }
 
-    // Runs both passes on the calling thread's pool and returns the region's pixels;
+    // Runs both passes on the calling thread's pool, handing the region's rows to the sink;
     // rethrows the first error.
     // `first` runs on the pool before the first tile.
-    std::vector<float> run(size_t stackBytes, const std::function<void()>& first) {
+    void run(size_t stackBytes, const std::function<void()>& first) {
         const ParallelLimits limits(opt_.threads, stackBytes);
         if (workers_.size() < static_cast<size_t>(parallelSlots()))
             workers_.resize(parallelSlots());
         first();
-        if (opt_.adaptive > 0)
-            renderInBands();
-        else
-            forTiles(1, halo_,
-                     [&](Worker& wk, int y, int x0, int x1) { sampleRow(wk, y, x0, x1); });
+        renderInBands();
         if (firstError_) std::rethrow_exception(firstError_);
         if (stop_) throw RenderCancelled();
-        return regionPixels();
     }
 
   private:
-    // The decision between the passes: not a pass of its own for tileTime and progress.
-    static constexpr int kDecide = 0;
+    // The decision between the passes, and the hand-over of finished rows to the sink: not
+    // passes of their own for tileTime and progress.
+    static constexpr int kDecide = 0, kEmit = 3;
+    // The rows of the image kept at once (the window): those of the band in pass 1, of the
+    // two before it (being decided and supersampled), of the one before them (being handed
+    // over) and the border rows above and below. (65 are in use at most: the last band's
+    // border row below is written in the step that hands over the band 65 rows above it.)
+    static constexpr int kWindowRows = 4 * kTile + 2;
 
     static int tileCount(const Region& r) {
         return ((r.width() + kTile - 1) / kTile) * ((r.height() + kTile - 1) / kTile);
     }
 
-    // The region's rows out of the buffer (the buffer itself when there is no border).
-    std::vector<float> regionPixels() {
-        if (halo_.x0 == region_.x0 && halo_.y0 == region_.y0 && halo_.x1 == region_.x1 &&
-            halo_.y1 == region_.y1)
-            return std::move(rgb_);
-        std::vector<float> out(region_.pixels() * 3);
-        const size_t row = static_cast<size_t>(region_.width()) * 3;
-        for (int y = region_.y0; y < region_.y1; ++y)
-            std::copy_n(pixelAt(rgb_, region_.x0, y), row,
-                        out.data() + static_cast<size_t>(y - region_.y0) * row);
-        return out;
-    }
-
     static int tilesAcross(const Region& r) { return (r.width() + kTile - 1) / kTile; }
     int bandCount() const { return (region_.height() + kTile - 1) / kTile; }
 
-    // Adaptive sampling (POV-Ray's +A, method 1) in bands of kTile rows of the region, so
-    // that a band's pass 2 follows its pass 1 closely and finds the expansions its rays
-    // made still in the cache (a terrain's patches: two whole-image passes had rebuilt
-    // nearly every patch for pass 2). Step k runs, on the pool, pass 1 of band k (with
-    // the image's border row above band 0 and below the last) beside pass 2 of band k-2;
-    // then decides band k-1, whose neighbours' centres are all in by then; then writes
-    // band k-2's supersampled pixels, which the decision of band k-1 was the last to read
-    // as centres. Each pixel depends only on its own samples and its neighbours' centres,
-    // so the image is the one two whole passes give.
+    // The region in bands of kTile rows, each band's rows handed to the sink a step or three
+    // after its pass 1, so that the image is kept as a window of kWindowRows rows (0.5 MB
+    // at 640 wide, where the whole image's floats were 3.7 MB). Without adaptive sampling
+    // step k runs pass 1 of band k beside the hand-over of band k-1.
+    //
+    // Adaptive sampling (POV-Ray's +A, method 1) goes band by band too, so that a band's
+    // pass 2 follows its pass 1 closely and finds the expansions its rays made still in the
+    // cache (a terrain's patches: two whole-image passes had rebuilt nearly every patch for
+    // pass 2). Step k runs, on the pool, pass 1 of band k (with the image's border row
+    // above band 0 and below the last) beside pass 2 of band k-2 and the hand-over of band
+    // k-3; then decides band k-1, whose neighbours' centres are all in by then; then
+    // writes band k-2's supersampled pixels, which the decision of band k-1 was the last
+    // to read as centres. Each pixel depends only on its own samples and its neighbours'
+    // centres, so the image is the one two whole passes give.
     void renderInBands() {
         const int bands = bandCount();
+        const bool adaptive = opt_.adaptive > 0;
+        const int lag = adaptive ? 3 : 1;  // from a band's pass 1 to its hand-over
         const uint64_t pass = ++adaptivePasses;
-        std::vector<uint8_t> differs(region_.pixels());
-        std::vector<float> band2;  // pass 2's pixels of the band in flight, by region row
-        for (int k = 0; k < bands + 2 && !stop_; ++k) {
+        for (int k = 0; k < bands + lag && !stop_; ++k) {
             std::vector<Job> jobs;
             if (k < bands) addTiles(jobs, 1, bandRows(k, true));
-            if (k >= 2) addTiles(jobs, 2, bandRows(k - 2, false));
-            band2.resize(static_cast<size_t>(bandRows(std::max(k - 2, 0), false).pixels()) * 3);
+            if (adaptive && k >= 2 && k - 2 < bands) addTiles(jobs, 2, bandRows(k - 2, false));
+            if (k >= lag) addRows(jobs, bandRows(k - lag, false));
             runJobs(jobs, [&](Worker& wk, int jobPass, int y, int x0, int x1) {
                 if (jobPass == 1) return sampleRow(wk, y, x0, x1);
+                if (jobPass == kEmit) return sink_(y, {pixelAt(x0, y), size_t(x1 - x0) * 3});
                 const int y0 = bandRows(k - 2, false).y0;
                 for (int x = x0; x < x1; ++x)
-                    if (differs[regionIndex(x, y)])
-                        supersamplePixel(wk, x, y, bandPixel(band2, x, y - y0));
+                    if (differs_[differsIndex(x, y)])
+                        supersamplePixel(wk, x, y, bandPixel(band2_, x, y - y0));
             });
+            if (!adaptive) continue;
             if (k >= 1 && k - 1 < bands && !stop_)
                 forTiles(kDecide, bandRows(k - 1, false), [&](Worker& wk, int y, int x0, int x1) {
                     for (int x = x0; x < x1; ++x)
-                        differs[regionIndex(x, y)] = differsFromNeighbour(wk, pass, x, y);
+                        differs_[differsIndex(x, y)] = differsFromNeighbour(wk, pass, x, y);
                 });
-            if (k >= 2 && !stop_) storeBand(bandRows(k - 2, false), differs, band2);
+            if (k >= 2 && k - 2 < bands && !stop_) storeBand(bandRows(k - 2, false));
         }
     }
 
@@ -204,12 +205,11 @@ class TileRender {
     }
 
     // Pass 2's pixels of a band into the image.
-    void storeBand(const Region& band, const std::vector<uint8_t>& differs,
-                   std::vector<float>& band2) {
+    void storeBand(const Region& band) {
         for (int y = band.y0; y < band.y1; ++y)
             for (int x = band.x0; x < band.x1; ++x)
-                if (differs[regionIndex(x, y)])
-                    std::copy_n(bandPixel(band2, x, y - band.y0), 3, pixelAt(rgb_, x, y));
+                if (differs_[differsIndex(x, y)])
+                    std::copy_n(bandPixel(band2_, x, y - band.y0), 3, pixelAt(x, y));
     }
 
     struct Job {
@@ -222,6 +222,12 @@ class TileRender {
             for (int x0 = area.x0; x0 < area.x1; x0 += kTile)
                 jobs.push_back({pass, Region{x0, y0, std::min(area.x1, x0 + kTile),
                                              std::min(area.y1, y0 + kTile)}});
+    }
+
+    // The hand-over of each of the area's rows, a job each.
+    static void addRows(std::vector<Job>& jobs, const Region& area) {
+        for (int y = area.y0; y < area.y1; ++y)
+            jobs.push_back({kEmit, Region{area.x0, y, area.x1, y + 1}});
     }
 
     // Runs row(worker, pass, y, x0, x1) over each job's tile, in parallel.
@@ -266,30 +272,31 @@ class TileRender {
             stop_ = true;
             return false;
         }
-        if (pass == kDecide) return true;
+        if (pass == kDecide || pass == kEmit) return true;
         if (opt_.tileTime) opt_.tileTime(pass, t.x0, t.y0, t.x1, t.y1, threadCpuSeconds() - start);
         const int d = ++done_;
         if (opt_.progress) opt_.progress(static_cast<double>(d) / totalWork_);
         return true;
     }
 
-    size_t regionIndex(int x, int y) const {
-        return static_cast<size_t>(y - region_.y0) * region_.width() + (x - region_.x0);
+    // Pixel (x, y)'s byte of `differs_`, which holds two bands.
+    size_t differsIndex(int x, int y) const {
+        return static_cast<size_t>((y - region_.y0) % (2 * kTile)) * region_.width() +
+               (x - region_.x0);
     }
 
-    // Pixel (x, y) of the image in the buffer, which holds halo_.
-    float* pixelAt(std::vector<float>& rgb, int x, int y) const {
-        return rgb.data() +
-               (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
+    // Pixel (x, y) of the image in the window: row y of halo_ is row y mod windowRows_.
+    float* pixelAt(int x, int y) {
+        return rgb_.data() + (static_cast<size_t>((y - halo_.y0) % windowRows_) * halo_.width() +
+                              (x - halo_.x0)) *
+                                 3;
     }
-    template <class T>
-    const T* pixelAt(const std::vector<T>& rgb, int x, int y) const {
-        return rgb.data() +
-               (static_cast<size_t>(y - halo_.y0) * halo_.width() + (x - halo_.x0)) * 3;
+    const float* pixelAt(int x, int y) const {
+        return const_cast<TileRender*>(this)->pixelAt(x, y);
     }
 
     void store(int x, int y, const Vec3& c) {
-        float* p = pixelAt(rgb_, x, y);
+        float* p = pixelAt(x, y);
         p[0] = static_cast<float>(c.x), p[1] = static_cast<float>(c.y),
         p[2] = static_cast<float>(c.z);
     }
@@ -352,7 +359,7 @@ class TileRender {
             wk.encoded.resize(wk.area.pixels() * 3);
             double* e = wk.encoded.data();
             for (int v = wk.area.y0; v < wk.area.y1; ++v) {
-                const float* c = pixelAt(rgb_, wk.area.x0, v);
+                const float* c = pixelAt(wk.area.x0, v);
                 for (int k = 0; k < wk.area.width() * 3; ++k) *e++ = wk.encode(c[k]);
             }
         }
@@ -363,11 +370,14 @@ class TileRender {
     // from a 4-neighbour's by the threshold or more. Reads pass 1's centres; encodes them
     // only where a neighbour is not near (NearColours), which most pixels are not.
     bool differsFromNeighbour(Worker& wk, uint64_t pass, int x, int y) const {
-        const float* p = pixelAt(rgb_, x, y);
+        const int r = (y - halo_.y0) % windowRows_;  // (one division for the three rows)
         const ptrdiff_t row = static_cast<ptrdiff_t>(halo_.width()) * 3;
+        const float* p = rgb_.data() + r * row + (x - halo_.x0) * 3;
+        const float* up = r > 0 ? p - row : p + (windowRows_ - 1) * row;
+        const float* down = r + 1 < windowRows_ ? p + row : p - (windowRows_ - 1) * row;
         // (a neighbour outside the image is the pixel itself, which is near)
         if (near_(p, x > 0 ? p - 3 : p) && near_(p, x + 1 < w_ ? p + 3 : p) &&
-            near_(p, y > 0 ? p - row : p) && near_(p, y + 1 < h_ ? p + row : p))
+            near_(p, y > 0 ? up : p) && near_(p, y + 1 < h_ ? down : p))
             return false;
         const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
         const double* encoded = encodedTile(wk, pass, x, y);
@@ -386,7 +396,7 @@ class TileRender {
     // averaged with its centre, into `out` (the image's pixel is written once the
     // neighbours' decisions have read its centre).
     void supersamplePixel(Worker& wk, int x, int y, float* out) {
-        const float* c = pixelAt(rgb_, x, y);
+        const float* c = pixelAt(x, y);
         const int depth = std::max(1, opt_.adaptiveDepth);
         const double step = 1.0 / depth, range = 0.5 - step * 0.5;
         // (the rays made first, as sampleRow's)
@@ -407,7 +417,11 @@ class TileRender {
     const Region region_, halo_;
     const int totalWork_;
     const NearColours near_;  // neighbours that cannot differ at the threshold
-    std::vector<float> rgb_;  // halo_'s pixels
+    const RowSink& sink_;
+    const int windowRows_;
+    std::vector<float> rgb_;        // the window: windowRows_ rows of halo_'s pixels
+    std::vector<uint8_t> differs_;  // adaptive sampling: the decision of two bands' pixels
+    std::vector<float> band2_;      // pass 2's pixels of the band in flight, by region row
     std::mutex errorMutex_;
     std::exception_ptr firstError_;
     std::atomic<bool> stop_{false};
@@ -477,24 +491,32 @@ RegionRenderer::RegionRenderer(const Graph& g, const RenderOptions& opt) {
 
 RegionRenderer::~RegionRenderer() = default;
 
-std::vector<float> RegionRenderer::render(const Region& region) {
+void RegionRenderer::render(const Region& region, const RowSink& rows) {
     State& s = *state_;
     if (region.x0 < 0 || region.y0 < 0 || region.x1 > s.opt.width || region.y1 > s.opt.height ||
         region.width() <= 0 || region.height() <= 0)
         throw std::invalid_argument("the region is not a non-empty part of the image");
     const auto t0 = std::chrono::steady_clock::now();
     const size_t stack = s.scene.stackBytesNeeded();
-    std::vector<float> rgb;
     // The walk recurses once per node visit: the calling thread gets a stack as large as
     // the scene needs, and so do the pool's threads.
     auto work = [&] {
-        rgb = TileRender(s.scene, s.camera, s.opt, s.workers, region).run(stack, [&] {
+        TileRender(s.scene, s.camera, s.opt, s.workers, region, rows).run(stack, [&] {
             s.prefill();
         });
     };
     runWithStack(stack, work);
     s.figures.seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::vector<float> RegionRenderer::render(const Region& region) {
+    std::vector<float> rgb;
+    if (region.width() > 0 && region.height() > 0) rgb.resize(region.pixels() * 3);
+    const size_t row = static_cast<size_t>(std::max(region.width(), 0)) * 3;
+    render(region, [&](int y, std::span<const float> pixels) {
+        std::copy(pixels.begin(), pixels.end(), rgb.data() + (y - region.y0) * row);
+    });
     return rgb;
 }
 
@@ -517,6 +539,12 @@ RenderResult render(const Graph& g, const RenderOptions& opt) {
     RenderResult result = renderer.figures();
     result.rgb = std::move(rgb);
     return result;
+}
+
+RenderResult render(const Graph& g, const RenderOptions& opt, const RowSink& rows) {
+    RegionRenderer renderer(g, opt);
+    renderer.render(Region{0, 0, opt.width, opt.height}, rows);
+    return renderer.figures();
 }
 
 }  // namespace pcsg::tracer

@@ -1,6 +1,11 @@
 // Rendering an image: pixels in tiles, in parallel on thread_pool.h's threads, anti-aliasing. The
 // result is linear float RGB; tools/image/ writes it to a file.
 //
+//  - Rows: the render keeps a window of the rows in flight (pass 1 in bands of 16 rows, and
+//    for adaptive sampling the two bands before, being decided and supersampled), not the
+//    whole image, and hands each finished row to a RowSink (a 640-wide window is 0.5 MB,
+//    the whole image's floats 3.7 MB). render() without a sink collects the rows into
+//    RenderResult::rgb.
 //  - Every pixel's colour depends only on the pixel (fixed sample positions, no shared
 //    mutable state), so the image is the same byte for byte whatever the thread count.
 //  - --aa N: N x N stratified samples at the centres of an N x N grid of sub-pixels,
@@ -29,6 +34,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -88,9 +94,15 @@ struct Region {
     size_t pixels() const { return static_cast<size_t>(width()) * height(); }
 };
 
+// Where a render's finished rows go: rows(y, rgb) once for each row y of the region, with
+// the region's width x 3 linear RGB floats, which are gone when it returns. It is called
+// on any of the render's threads, in no set order (different rows at the same time), and
+// an exception it throws stops the render as a tile's would.
+using RowSink = std::function<void(int y, std::span<const float> rgb)>;
+
 struct RenderResult {
     int width = 0, height = 0;
-    std::vector<float> rgb;  // linear RGB, row-major from the top-left
+    std::vector<float> rgb;  // linear RGB, row-major from the top-left (empty with a RowSink)
     uint64_t rays = 0;
     uint64_t nodeVisits = 0;
     double seconds = 0;              // the render proper
@@ -103,6 +115,8 @@ struct RenderResult {
 // Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)
 // or std::runtime_error (the stack cannot be made large enough).
 RenderResult render(const Graph& g, const RenderOptions& options);
+// The same, each row handed to `rows` as it is finished (the result has no pixels).
+RenderResult render(const Graph& g, const RenderOptions& options, const RowSink& rows);
 
 // The scene made ready once (hyper-bounding boxes, trace scene, camera) and rendered a
 // region at a time, each region's pixels exactly those render() gives them. The graph
@@ -117,6 +131,8 @@ class RegionRenderer {
     // The region's linear RGB, row-major. Throws as render() does; options.progress is
     // called with the fraction of this region done.
     std::vector<float> render(const Region& region);
+    // The same, each row handed to `rows` as it is finished.
+    void render(const Region& region, const RowSink& rows);
 
     // The figures so far (no pixels): rays, node visits and expansions of every region,
     // the bounds' time, and `seconds`, the set-up and every region's render.

@@ -6,6 +6,8 @@
 //
 // A PNG is written in this process through libpng (tools/image/png_writer.h), so that the
 // whole command stays small: OpenImageIO's ~260 shared libraries would cost it ~130 MB.
+// Its rows go into the file as the render finishes them (png_writer.h's PngRows): the
+// image is never held whole, as floats (3.7 MB at 640x480) nor as bytes (0.9 MB).
 // An EXR or TIFF file is written by the pcsg-image helper (tools/image/image_helper.h),
 // run once the pixels exist, which gets them through a pipe. The peak RSS printed is the
 // whole command's (this process's, or the helper's when that is larger), what
@@ -44,7 +46,6 @@
 #include "distributed_render.h"
 #include "eval.h"
 #include "expander.h"
-#include "frame_writer.h"
 #include "frames.h"
 #include "image_format.h"
 #include "image_helper.h"
@@ -118,6 +119,9 @@ struct RenderReport {
     Stats stats;
     ExpansionCount count;
     tracer::RenderResult result;  // its pixels released once written
+    // A PNG, written as the render hands over its rows (opened before it; null for the
+    // other formats, whose floats are result.rgb, and under MPI).
+    std::unique_ptr<PngRows> png;
     size_t graphNodes = 0;
     double imageWriteSeconds = 0;            // writing the image file
     std::optional<ImageWriteResult> helper;  // pcsg-image, for EXR and TIFF
@@ -131,7 +135,10 @@ std::string writeOutput(const RenderCommandOptions& o, const std::string& imageH
     const std::span<const float> rgb = report.result.rgb;
     if (imageFormatOf(o.output) == ImageFormat::png) {
         try {
-            writePng(o.output, o.width, o.height, rgb);
+            if (report.png)
+                report.png->finish();
+            else
+                writePng(o.output, o.width, o.height, rgb);
         } catch (const std::runtime_error& e) {
             return e.what();
         }
@@ -249,8 +256,34 @@ class FillCounts {
 // found stored) itself. What is reported stays the serial order's: an error of the count
 // wins over the render's (the render is cancelled and its pixels dropped), then the
 // render's own error; nothing is written unless both succeed.
+// Opens the PNG the render's rows go to (RenderReport::png): 2 with the error printed
+// when it cannot be written.
+int openPng(const RenderCommandOptions& o, RenderReport& report, const std::string& frameNote) {
+    if (imageFormatOf(o.output) != ImageFormat::png) return 0;
+    try {
+        report.png = std::make_unique<PngRows>(o.output, o.width, o.height);
+    } catch (const std::runtime_error& e) {
+        std::cerr << "pcsg render: " << e.what() << frameNote << "\n";
+        return 2;
+    }
+    return 0;
+}
+
+// Where the render's rows go: into the PNG as they are finished (the image is never held
+// whole: 3.7 MB of floats at 640x480), or, for the helper's formats, into `floats`.
+tracer::RowSink outputRows(const RenderCommandOptions& o, RenderReport& report,
+                           std::vector<float>& floats) {
+    if (report.png)
+        return [png = report.png.get()](int y, std::span<const float> rgb) { png->put(y, rgb); };
+    const size_t row = static_cast<size_t>(o.width) * 3;
+    floats.resize(row * o.height);
+    return [&floats, row](int y, std::span<const float> rgb) {
+        std::copy(rgb.begin(), rgb.end(), floats.begin() + y * row);
+    };
+}
+
 void countBesideRender(const Graph& g, CountOptions co, tracer::RenderOptions ro,
-                       RenderReport& report) {
+                       const tracer::RowSink& rows, RenderReport& report) {
     std::atomic<bool> cancel{false};
     if (ro.cancel) throw std::logic_error("countBesideRender: the render has its own cancel flag");
     ro.cancel = &cancel;
@@ -270,7 +303,7 @@ void countBesideRender(const Graph& g, CountOptions co, tracer::RenderOptions ro
         }
     });
     try {
-        report.result = tracer::render(g, ro);
+        report.result = tracer::render(g, ro, rows);
     } catch (...) {
         renderError = std::current_exception();
     }
@@ -300,6 +333,7 @@ int countAndRender(Graph& g, const RenderCommandOptions& o, RenderReport& report
         if (showProgress) bar->finish();
         return status;
     }
+    if (const int status = openPng(o, report, frameNote)) return status;
     auto times = std::make_shared<TileTimes>();
     if (!o.tileTimes.empty())
         ro.tileTime = [times](int pass, int x0, int y0, int x1, int y1, double seconds) {
@@ -308,7 +342,9 @@ int countAndRender(Graph& g, const RenderCommandOptions& o, RenderReport& report
     try {
         CountOptions co;
         co.maxVisits = o.countVisits;
-        countBesideRender(g, co, ro, report);
+        std::vector<float> floats;
+        countBesideRender(g, co, ro, outputRows(o, report, floats), report);
+        report.result.rgb = std::move(floats);
     } catch (const RuntimeError& e) {
         if (showProgress) bar->finish();
         std::cerr << e.format(g) << frameNote << "\n";
@@ -470,48 +506,26 @@ int renderFrame(const RenderCommandOptions& o, const FramePlan& plan, int f, Gra
     return 0;
 }
 
-// Writes the rendered frame's file: a PNG on the writer's thread (collected by
-// collectFrame), another format here. Releases the pixels either way: `= {}` would clear
-// them but keep their memory, a whole image per frame held to the end of the sequence.
+// Writes the rendered frame's file (a PNG's rows are in it already: it is ended and
+// renamed) and prints its line. Releases the pixels: `= {}` would clear them but keep
+// their memory, a whole image per frame held to the end of the sequence.
 int writeFrame(const RenderCommandOptions& o, const FramePlan& plan, const std::string& imageHelper,
-               FrameWriter& writer, RenderReport& report, FrameFigures& out) {
-    if (imageFormatOf(out.output) == ImageFormat::png) {
-        writer.start(out.output, o.width, o.height, report.result.rgb);
-    } else {
-        RenderCommandOptions fo = o;
-        fo.output = out.output;
-        if (const std::string error = writeOutput(fo, imageHelper, report); !error.empty()) {
-            std::cerr << "pcsg render: " << error << frameNote(plan, out.frame, out.clock) << "\n";
-            return 2;
-        }
-        out.imageWriteSeconds = report.imageWriteSeconds;
+               RenderReport& report, FrameFigures& out) {
+    RenderCommandOptions fo = o;
+    fo.output = out.output;
+    if (const std::string error = writeOutput(fo, imageHelper, report); !error.empty()) {
+        std::cerr << "pcsg render: " << error << frameNote(plan, out.frame, out.clock) << "\n";
+        return 2;
     }
+    out.imageWriteSeconds = report.imageWriteSeconds;
     report.result.rgb = std::vector<float>();
+    report.png.reset();
     out.result = std::move(report.result);
-    return 0;
-}
-
-// The frame last handed to writeFrame, once its file is written (waiting for the writer's
-// thread): printed and added to `done`. 2 when its PNG could not be written.
-int collectFrame(const RenderCommandOptions& o, const FramePlan& plan, FrameWriter& writer,
-                 std::optional<FrameFigures>& last, std::vector<FrameFigures>& done) {
-    if (!last) return 0;
-    FrameFigures figures = std::move(*last);
-    last.reset();
-    if (const auto written = writer.done()) {
-        if (!written->error.empty()) {
-            std::cerr << "pcsg render: " << written->error
-                      << frameNote(plan, figures.frame, figures.clock) << "\n";
-            return 2;
-        }
-        figures.imageWriteSeconds = written->seconds;
-    }
     if (!o.json)
         std::cout << fmt::format("frame {} of {} (clock {}): wrote {} in {:.3f} s, {} rays\n",
-                                 figures.frame, plan.frames, figures.clock, figures.output,
-                                 figures.result.seconds, figures.result.rays)
+                                 out.frame, plan.frames, out.clock, out.output, out.result.seconds,
+                                 out.result.rays)
                   << std::flush;
-    done.push_back(std::move(figures));
     return 0;
 }
 
@@ -649,21 +663,15 @@ int runFrames(const RenderCommandOptions& o, const FramePlan& plan, CompiledScen
     // One bar over the whole sequence, cleared while a frame's line is printed.
     auto bar = std::make_shared<ProgressBar>();
     const bool showProgress = isatty(STDERR_FILENO) != 0;
-    // Frame f renders while frame f-1's PNG is written; a failed write of f-1 is reported
-    // after f's render (and its error, if it had one) and ends the sequence.
-    FrameWriter writer(o.threads);
-    std::optional<FrameFigures> last;
     for (int f = plan.first; f <= plan.last; ++f) {
         FrameFigures figures;
         RenderReport report;
         int status = renderFrame(o, plan, f, g, bounds, bar, figures, report);
         if (showProgress) bar->finish();
-        if (const int written = collectFrame(o, plan, writer, last, done)) return written;
-        if (status == 0) status = writeFrame(o, plan, imageHelper, writer, report, figures);
+        if (status == 0) status = writeFrame(o, plan, imageHelper, report, figures);
         if (status) return status;
-        last = std::move(figures);
+        done.push_back(std::move(figures));
     }
-    if (const int written = collectFrame(o, plan, writer, last, done)) return written;
     printFrames(o, plan, g, compiled, done, bounds.seconds());
     return 0;
 }
@@ -769,6 +777,7 @@ int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
         return 2;
     }
     report.result.rgb = std::vector<float>();  // written: the printing needs only the figures
+    report.png.reset();
     report.graphNodes = g.nodes.size();
     Stats& s = report.stats;
     s.scene = o.scene;

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
 
 #include "image_format.h"
@@ -25,7 +26,8 @@ namespace fs = std::filesystem;
 constexpr size_t kMessageSize = 256;
 
 // libpng reports an error through its callback, which must not return: this one keeps the
-// message (in the error pointer's buffer) and jumps back to encode()'s setjmp.
+// message (in the error pointer's buffer) and jumps back to the setjmp of the step that
+// called libpng.
 [[noreturn]] void onPngError(png_structp png, png_const_charp message) {
     char* into = static_cast<char*>(png_get_error_ptr(png));
     std::snprintf(into, kMessageSize, "%s", message);
@@ -34,21 +36,11 @@ constexpr size_t kMessageSize = 256;
 
 void onPngWarning(png_structp, png_const_charp) {}
 
-// Encodes the image into an open file; false with the message in `error` (kMessageSize
-// bytes) when libpng failed. No C++ object lives across the setjmp.
-bool encode(FILE* file, int width, int height, const uint8_t* bytes, char* error) {
-    png_structp png =
-        png_create_write_struct(PNG_LIBPNG_VER_STRING, error, onPngError, onPngWarning);
-    png_infop info = png ? png_create_info_struct(png) : nullptr;
-    if (!info) {
-        png_destroy_write_struct(&png, nullptr);
-        std::snprintf(error, kMessageSize, "libpng could not start");
-        return false;
-    }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        return false;
-    }
+// libpng's steps, each behind a setjmp of its own (libpng reports an error by a longjmp
+// back to it, the message in the error pointer's buffer): false when libpng failed. No C++
+// object lives across a setjmp.
+bool startPng(png_structp png, png_infop info, FILE* file, int width, int height) {
+    if (setjmp(png_jmpbuf(png))) return false;
     png_init_io(png, file);
     png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                  PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
@@ -69,10 +61,18 @@ bool encode(FILE* file, int width, int height, const uint8_t* bytes, char* error
     png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
     png_set_compression_level(png, 1);
     png_write_info(png, info);
-    const size_t stride = static_cast<size_t>(width) * 3;
-    for (int y = 0; y < height; ++y) png_write_row(png, bytes + static_cast<size_t>(y) * stride);
+    return true;
+}
+
+bool writePngRow(png_structp png, const uint8_t* row) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_write_row(png, row);
+    return true;
+}
+
+bool endPng(png_structp png, png_infop info) {
+    if (setjmp(png_jmpbuf(png))) return false;
     png_write_end(png, info);
-    png_destroy_write_struct(&png, &info);
     return true;
 }
 
@@ -147,33 +147,104 @@ void writePng(const std::string& path, int width, int height, std::span<const fl
 }
 
 void writePngBytes(const std::string& path, int width, int height, std::span<const uint8_t> bytes) {
-    auto fail = [&](const std::string& why) {
-        throw std::runtime_error(fmt::format("cannot write '{}': {}", path, why));
-    };
-    if (width <= 0 || height <= 0)
-        fail(fmt::format("the image size {}x{} is not positive", width, height));
-    const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height) * 3;
-    if (bytes.size() != n)
-        fail(fmt::format("{} values for a {}x{} RGB image (expected {})", bytes.size(), width,
-                         height, n));
+    if (width > 0 && height > 0 && bytes.size() != static_cast<size_t>(width) * height * 3)
+        throw std::runtime_error(
+            fmt::format("cannot write '{}': {} values for a {}x{} RGB image (expected {})", path,
+                        bytes.size(), width, height, static_cast<size_t>(width) * height * 3));
+    PngRowWriter png(path, width, height);
+    const size_t stride = static_cast<size_t>(width) * 3;
+    for (int y = 0; y < height; ++y) png.write(bytes.subspan(y * stride, stride));
+    png.finish();
+}
 
-    const fs::path target(path);
-    const fs::path tmp = temporaryBeside(target);
-    FILE* file = std::fopen(tmp.c_str(), "wb");
-    if (!file) fail(std::strerror(errno));
+// The file being written: its temporary name, libpng's state, and whether it is done.
+struct PngRowWriter::State {
+    std::string path;
+    int width = 0, height = 0, rows = 0;
+    fs::path tmp;
+    FILE* file = nullptr;
+    png_structp png = nullptr;
+    png_infop info = nullptr;
     char message[kMessageSize] = "";
-    std::string error;
-    if (!encode(file, width, height, bytes.data(), message)) error = message;
+    bool finished = false;
+
+    ~State() { close(); }
+    // Lets go of libpng and the file, and removes the file unless it was finished.
+    void close() {
+        if (png) png_destroy_write_struct(&png, &info);
+        png = nullptr, info = nullptr;
+        if (file) std::fclose(file);
+        file = nullptr;
+        std::error_code ec;
+        if (!finished && !tmp.empty()) fs::remove(tmp, ec);
+    }
+    [[noreturn]] void fail(const std::string& why) {
+        close();
+        throw std::runtime_error(fmt::format("cannot write '{}': {}", path, why));
+    }
+};
+
+PngRowWriter::PngRowWriter(const std::string& path, int width, int height)
+    : state_(std::make_unique<State>()) {
+    State& s = *state_;
+    s.path = path, s.width = width, s.height = height;
+    if (width <= 0 || height <= 0)
+        s.fail(fmt::format("the image size {}x{} is not positive", width, height));
+    s.tmp = temporaryBeside(fs::path(path));
+    s.file = std::fopen(s.tmp.c_str(), "wb");
+    if (!s.file) {
+        const std::string why = std::strerror(errno);
+        s.tmp.clear();  // (nothing was made)
+        s.fail(why);
+    }
+    s.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, s.message, onPngError, onPngWarning);
+    s.info = s.png ? png_create_info_struct(s.png) : nullptr;
+    if (!s.info) s.fail("libpng could not start");
+    if (!startPng(s.png, s.info, s.file, width, height)) s.fail(s.message);
+}
+
+PngRowWriter::~PngRowWriter() = default;
+
+void PngRowWriter::write(std::span<const uint8_t> row) {
+    State& s = *state_;
+    if (!s.png) s.fail("the file was closed by an earlier error");
+    if (row.size() != static_cast<size_t>(s.width) * 3 || s.rows >= s.height)
+        s.fail(fmt::format("row {} of {} values for a {}x{} RGB image", s.rows, row.size(), s.width,
+                           s.height));
+    if (!writePngRow(s.png, row.data())) s.fail(s.message);
+    ++s.rows;
+}
+
+void PngRowWriter::finish() {
+    State& s = *state_;
+    if (!s.png) s.fail("the file was closed by an earlier error");
+    if (s.rows != s.height) s.fail(fmt::format("{} rows of {} written", s.rows, s.height));
+    if (!endPng(s.png, s.info)) s.fail(s.message);
+    png_destroy_write_struct(&s.png, &s.info);
+    s.png = nullptr, s.info = nullptr;
     // fclose flushes what stdio buffered: it can fail too (a full disk).
-    const bool flushed = std::ferror(file) == 0;
-    const bool closed = std::fclose(file) == 0;
-    if (error.empty() && (!flushed || !closed)) error = std::strerror(errno);
+    const bool flushed = std::ferror(s.file) == 0;
+    const bool closed = std::fclose(s.file) == 0;
+    s.file = nullptr;
+    if (!flushed || !closed) s.fail(std::strerror(errno));
     std::error_code ec;
-    if (error.empty()) fs::rename(tmp, target, ec);
-    if (ec) error = ec.message();
-    if (!error.empty()) {
-        fs::remove(tmp, ec);
-        fail(error);
+    fs::rename(s.tmp, fs::path(s.path), ec);
+    if (ec) s.fail(ec.message());
+    s.finished = true;
+}
+
+void PngRows::put(int y, std::span<const float> rgb) {
+    std::vector<uint8_t> bytes(rgb.size());
+    srgbBytesInto(rgb, bytes);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (y != next_) {
+        waiting_.emplace(y, std::move(bytes));
+        return;
+    }
+    png_.write(bytes);
+    for (++next_; !waiting_.empty() && waiting_.begin()->first == next_; ++next_) {
+        png_.write(waiting_.begin()->second);
+        waiting_.erase(waiting_.begin());
     }
 }
 

@@ -7,13 +7,16 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli_test_util.h"
@@ -25,6 +28,7 @@ namespace {
 
 using testing::filesIn;
 using testing::readBack;
+using testing::readFile;
 using testing::TempDir;
 
 // Black, white, mid-grey, clamping above 1 and below 0, and the linear segment near 0,
@@ -152,6 +156,62 @@ TEST(PngWriter, AFailureNamesTheFileAndLeavesNothing) {
         EXPECT_EQ(std::string(e.what()).rfind("cannot write '" + out + "': ", 0), 0u) << e.what();
     }
     EXPECT_THROW(writePng(dir.file("img.png"), 2, 1, kPixels), std::runtime_error);  // sizes
+    EXPECT_TRUE(filesIn(dir.path()).empty());
+}
+
+// The render hands its rows to PngRows in bands, in any order and from several threads:
+// the file is writePng()'s byte for byte whatever the order, though no row is held longer
+// than the rows above it take to come.
+TEST(PngWriter, RowsInAnyOrderGiveWritePngsFile) {
+    const int w = 23, h = 50;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> value(-0.1f, 1.2f);
+    std::vector<float> rgb(static_cast<size_t>(w) * h * 3);
+    for (float& v : rgb) v = value(rng);
+    TempDir dir;
+    writePng(dir.file("ref.png"), w, h, rgb);
+    std::vector<int> order(h);
+    for (int y = 0; y < h; ++y) order[y] = y;
+    for (int round = 0; round < 3; ++round) {
+        std::shuffle(order.begin(), order.end(), rng);
+        const std::string out = dir.file("rows" + std::to_string(round) + ".png");
+        PngRows png(out, w, h);
+        auto put = [&](int first) {  // every other row of the order
+            for (int k = first; k < h; k += 2)
+                png.put(order[k], std::span(rgb).subspan(order[k] * w * 3, w * 3));
+        };
+        std::thread other(put, 1);
+        put(0);
+        other.join();
+        EXPECT_FALSE(std::filesystem::exists(out)) << "renamed before finish()";
+        png.finish();
+        EXPECT_EQ(readFile(out), readFile(dir.file("ref.png"))) << "round " << round;
+    }
+}
+
+// A PNG whose rows did not all come, or that was never finished, leaves nothing behind.
+TEST(PngWriter, AnUnfinishedPngLeavesNothing) {
+    TempDir dir;
+    {
+        PngRowWriter png(dir.file("a.png"), 3, 2);
+        png.write(k8Bit);
+        EXPECT_EQ(filesIn(dir.path()).size(), 1u);  // its temporary file
+        try {
+            png.finish();
+            ADD_FAILURE() << "finished with one row of two";
+        } catch (const std::runtime_error& e) {
+            EXPECT_EQ(std::string(e.what()).rfind("cannot write '" + dir.file("a.png") + "': ", 0),
+                      0u)
+                << e.what();
+        }
+        EXPECT_THROW(png.write(k8Bit), std::runtime_error);  // closed by the error
+    }
+    {
+        PngRows rows(dir.file("b.png"), 3, 1);
+        rows.put(0, kPixels);
+    }  // not finished
+    EXPECT_TRUE(filesIn(dir.path()).empty());
+    EXPECT_THROW(PngRowWriter(dir.file("no/such/dir/c.png"), 3, 1), std::runtime_error);
     EXPECT_TRUE(filesIn(dir.path()).empty());
 }
 
