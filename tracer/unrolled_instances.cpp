@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "bounds.h"
+#include "bvh_slabs.h"
 #include "eval.h"
 #include "flat_index.h"
 #include "outward_float.h"
@@ -704,53 +705,6 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         });
 }
 
-namespace {
-
-// Where the ray enters each of a BVH node's child boxes within [tmin, tmax] (t0[c]), and
-// which it meets at all (bit c of the result; never an empty slot). Boxes are only
-// culling here: hits do not depend on them, so they are tested two at a time in SSE2
-// registers, in doubles, with the same rule as clipToBox for a NaN (it culls nothing).
-int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, double tmin, double tmax,
-                  double t0[4]) {
-    int used = 0;
-    for (int c = 0; c < 4; ++c) used |= (b.child[c] != kNone) << c;
-    const Vec3& inv = r.inverse();
-#if defined(__SSE2__)
-    if (!r.hasZeroAxis()) {
-        __m128d lo[2] = {_mm_set1_pd(tmin), _mm_set1_pd(tmin)};
-        __m128d hi[2] = {_mm_set1_pd(tmax), _mm_set1_pd(tmax)};
-        for (int a = 0; a < 3; ++a) {
-            const __m128d o = _mm_set1_pd(r.o[a]), iv = _mm_set1_pd(inv[a]);
-            const __m128 bl = _mm_load_ps(b.lo[a]), bh = _mm_load_ps(b.hi[a]);
-            const __m128d l[2] = {_mm_cvtps_pd(bl), _mm_cvtps_pd(_mm_movehl_ps(bl, bl))};
-            const __m128d h[2] = {_mm_cvtps_pd(bh), _mm_cvtps_pd(_mm_movehl_ps(bh, bh))};
-            for (int p = 0; p < 2; ++p) {
-                const __m128d x = _mm_mul_pd(_mm_sub_pd(l[p], o), iv);
-                const __m128d y = _mm_mul_pd(_mm_sub_pd(h[p], o), iv);
-                lo[p] = _mm_max_pd(_mm_min_pd(y, x), lo[p]);
-                hi[p] = _mm_min_pd(_mm_max_pd(x, y), hi[p]);
-            }
-        }
-        _mm_storeu_pd(t0, lo[0]);
-        _mm_storeu_pd(t0 + 2, lo[1]);
-        const int mask = _mm_movemask_pd(_mm_cmple_pd(lo[0], hi[0])) |
-                         (_mm_movemask_pd(_mm_cmple_pd(lo[1], hi[1])) << 2);
-        return mask & used;
-    }
-#endif
-    int mask = 0;
-    for (int c = 0; c < 4; ++c) {
-        if (!(used & (1 << c))) continue;
-        const Box box{{b.lo[0][c], b.lo[1][c], b.lo[2][c]}, {b.hi[0][c], b.hi[1][c], b.hi[2][c]}};
-        double t1 = tmax;
-        t0[c] = tmin;
-        if (clipToBox(box, r, t0[c], t1)) mask |= 1 << c;
-    }
-    return mask;
-}
-
-}  // namespace
-
 // The first hit in a union's BVH: the nodes front to back by the ray's entry into them
 // (a stack of the ones still to visit, nearer ones on top), each skipped once its entry
 // lies beyond the nearest hit so far. (The order only saves work: a hit is the nearest
@@ -768,6 +722,9 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
     int top = 0;
     stack[top++] = {root, kNone, tmin};
     const uint64_t stamp = ++s.stamp;
+#if defined(__SSE2__)
+    const FloatRay fr = floatRay(r, tmin);
+#endif
     bool found = false;
     while (top > 0) {
         const Pending p = stack[--top];
@@ -785,7 +742,12 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
         }
         const BvhNode& b = bvh_[p.child];
         double t0[4];
+#if defined(__SSE2__)
+        int mask =
+            fr.ok ? enterChildrenFloat(b, fr, tmax, t0) : enterChildren(b, r, tmin, tmax, t0);
+#else
         int mask = enterChildren(b, r, tmin, tmax, t0);
+#endif
         // The children met, farthest pushed first (by insertion: at most four).
         const int base = top;
         for (; mask != 0; mask &= mask - 1) {
