@@ -301,8 +301,13 @@ class Unroller {
 
     // --- the first-hit BVHs of unions ---
 
-    // Flattening stops where an operand would need more matrices than this on its way.
-    static constexpr uint32_t kMaxChain = 12;
+    // Flattening stops where an operand would need more matrices than this on its way
+    // (linkedRay recurses once per matrix). The chains' links are shared and each link's
+    // ray is computed once per walk, so a longer chain costs only the links a ray meets:
+    // at 12 the growing tree's crown, three or four matrices a level, was cut every few
+    // levels into a BVH of its own, entered through the leaf's box in the outer frame
+    // (a box of a box) and walked again; at 32 its expansion is one hierarchy.
+    static constexpr uint32_t kMaxChain = 32;
     // Unions of this many operands (after flattening) or fewer get no BVH.
     static constexpr size_t kFewItems = 4;
 
