@@ -355,12 +355,21 @@ class Unroller {
             }
             const Box box =
                 link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
+            out_.nodes_[c].looseInBvh = link != kNone && !scaledPermutation(toU);
             items.push_back({c, link, box});
             parts_.push_back({c | UnrolledInstance::kLeaf, link, box, 0});
         }
         const Part whole = pairUp(base, parts_.size());
         parts_.resize(base);
         return whole;
+    }
+
+    // Whether m maps boxes to boxes (each row of its linear part has at most one nonzero
+    // entry): else the box of a mapped box is larger than what it holds.
+    static bool scaledPermutation(const Affine& m) {
+        for (const auto& row : m.l)
+            if ((row[0] != 0) + (row[1] != 0) + (row[2] != 0) > 1) return false;
+        return true;
     }
 
     // The binary hierarchy over parts_[begin, end) in their order, halved at the middle.
@@ -569,6 +578,11 @@ std::vector<std::vector<uint32_t>> UnrolledInstance::bvhLeafGroups() const {
     return groups;
 }
 
+size_t UnrolledInstance::looseOperands() const {
+    return static_cast<size_t>(
+        std::count_if(nodes_.begin(), nodes_.end(), [](const Node& n) { return n.looseInBvh; }));
+}
+
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
     LocalRay rr = r;
     for (uint32_t k = 0; k < node.matrices; ++k) {
@@ -629,6 +643,10 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                                const Use& use, bool anyHit, Scratch& s) const {
     ++s.visits;
     const Node& node = nodes_[n];
+    if (node.looseInBvh) {  // (its own box is tighter than the one the BVH tested)
+        double t0 = tmin, t1 = tmax;
+        if (!clipToBox(node.box, r, t0, t1)) return false;
+    }
     const LocalRay rr = enter(node, r);
     const uint32_t material = node.material == kInherit ? use.material : node.material;
     const uint32_t paint = node.material == kInherit ? use.paint : 0;

@@ -380,5 +380,18 @@ TEST(ExpandedInstances, UnionsBelowLongChainsOfMatricesAreOneHierarchy) {
     EXPECT_GT(compareWithGraphWalk(kDeepChains, 1.5, 100), 0u);
 }
 
+// Operands of a hierarchy whose box there is a box of their box through rotations test
+// their own box before they are entered (the spheres below kDeepChains' rotations);
+// below moves and scales (Sierpinski) the two are the same box, and none does.
+TEST(ExpandedInstances, OperandsBelowRotationsTestTheirOwnBoxes) {
+    const auto rotated = expandAxiom(kDeepChains);
+    ASSERT_TRUE(rotated);
+    EXPECT_EQ(rotated->looseOperands(), 32u);
+    const auto straight = expandAxiom(testing::kSierpinski);
+    ASSERT_TRUE(straight);
+    EXPECT_GT(straight->bvhNodes(), 0u);
+    EXPECT_EQ(straight->looseOperands(), 0u);
+}
+
 }  // namespace
 }  // namespace pcsg::tracer
