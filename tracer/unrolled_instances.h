@@ -80,7 +80,7 @@ class UnrolledInstance {
     // flower's 21 petals as a chain 21 unions deep). Spans still follow the derivation.
     // A node holds the boxes of up to four children side by side, in floats rounded
     // outwards (boxes only cull: a larger box never changes a hit), so that a node is two
-    // cache lines and SSE2 tests an axis of two children at a time; child c is another
+    // cache lines and one SSE register holds an axis of all four; child c is another
     // node (bvh_[child[c]]), or, with kLeaf set, an operand (nodes_[child[c] & ~kLeaf])
     // entered through the chain of matrices link[c] (links_; kNone: none) and then its
     // own, or kNone: an empty slot (after the used ones).
