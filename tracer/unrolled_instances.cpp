@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "bounds.h"
+#include "bvh_slabs.h"
 #include "eval.h"
 #include "flat_index.h"
 #include "outward_float.h"
@@ -300,8 +301,13 @@ class Unroller {
 
     // --- the first-hit BVHs of unions ---
 
-    // Flattening stops where an operand would need more matrices than this on its way.
-    static constexpr uint32_t kMaxChain = 12;
+    // Flattening stops where an operand would need more matrices than this on its way
+    // (linkedRay recurses once per matrix). The chains' links are shared and each link's
+    // ray is computed once per walk, so a longer chain costs only the links a ray meets:
+    // at 12 the growing tree's crown, three or four matrices a level, was cut every few
+    // levels into a BVH of its own, entered through the leaf's box in the outer frame
+    // (a box of a box) and walked again; at 32 its expansion is one hierarchy.
+    static constexpr uint32_t kMaxChain = 32;
     // Unions of this many operands (after flattening) or fewer get no BVH.
     static constexpr size_t kFewItems = 4;
 
@@ -349,12 +355,21 @@ class Unroller {
             }
             const Box box =
                 link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
+            out_.nodes_[c].looseInBvh = link != kNone && !scaledPermutation(toU);
             items.push_back({c, link, box});
             parts_.push_back({c | UnrolledInstance::kLeaf, link, box, 0});
         }
         const Part whole = pairUp(base, parts_.size());
         parts_.resize(base);
         return whole;
+    }
+
+    // Whether m maps boxes to boxes (each row of its linear part has at most one nonzero
+    // entry): else the box of a mapped box is larger than what it holds.
+    static bool scaledPermutation(const Affine& m) {
+        for (const auto& row : m.l)
+            if ((row[0] != 0) + (row[1] != 0) + (row[2] != 0) > 1) return false;
+        return true;
     }
 
     // The binary hierarchy over parts_[begin, end) in their order, halved at the middle.
@@ -563,6 +578,11 @@ std::vector<std::vector<uint32_t>> UnrolledInstance::bvhLeafGroups() const {
     return groups;
 }
 
+size_t UnrolledInstance::looseOperands() const {
+    return static_cast<size_t>(
+        std::count_if(nodes_.begin(), nodes_.end(), [](const Node& n) { return n.looseInBvh; }));
+}
+
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
     LocalRay rr = r;
     for (uint32_t k = 0; k < node.matrices; ++k) {
@@ -623,6 +643,10 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                                const Use& use, bool anyHit, Scratch& s) const {
     ++s.visits;
     const Node& node = nodes_[n];
+    if (node.looseInBvh) {  // (its own box is tighter than the one the BVH tested)
+        double t0 = tmin, t1 = tmax;
+        if (!clipToBox(node.box, r, t0, t1)) return false;
+    }
     const LocalRay rr = enter(node, r);
     const uint32_t material = node.material == kInherit ? use.material : node.material;
     const uint32_t paint = node.material == kInherit ? use.paint : 0;
@@ -704,53 +728,6 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         });
 }
 
-namespace {
-
-// Where the ray enters each of a BVH node's child boxes within [tmin, tmax] (t0[c]), and
-// which it meets at all (bit c of the result; never an empty slot). Boxes are only
-// culling here: hits do not depend on them, so they are tested two at a time in SSE2
-// registers, in doubles, with the same rule as clipToBox for a NaN (it culls nothing).
-int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, double tmin, double tmax,
-                  double t0[4]) {
-    int used = 0;
-    for (int c = 0; c < 4; ++c) used |= (b.child[c] != kNone) << c;
-    const Vec3& inv = r.inverse();
-#if defined(__SSE2__)
-    if (!r.hasZeroAxis()) {
-        __m128d lo[2] = {_mm_set1_pd(tmin), _mm_set1_pd(tmin)};
-        __m128d hi[2] = {_mm_set1_pd(tmax), _mm_set1_pd(tmax)};
-        for (int a = 0; a < 3; ++a) {
-            const __m128d o = _mm_set1_pd(r.o[a]), iv = _mm_set1_pd(inv[a]);
-            const __m128 bl = _mm_load_ps(b.lo[a]), bh = _mm_load_ps(b.hi[a]);
-            const __m128d l[2] = {_mm_cvtps_pd(bl), _mm_cvtps_pd(_mm_movehl_ps(bl, bl))};
-            const __m128d h[2] = {_mm_cvtps_pd(bh), _mm_cvtps_pd(_mm_movehl_ps(bh, bh))};
-            for (int p = 0; p < 2; ++p) {
-                const __m128d x = _mm_mul_pd(_mm_sub_pd(l[p], o), iv);
-                const __m128d y = _mm_mul_pd(_mm_sub_pd(h[p], o), iv);
-                lo[p] = _mm_max_pd(_mm_min_pd(y, x), lo[p]);
-                hi[p] = _mm_min_pd(_mm_max_pd(x, y), hi[p]);
-            }
-        }
-        _mm_storeu_pd(t0, lo[0]);
-        _mm_storeu_pd(t0 + 2, lo[1]);
-        const int mask = _mm_movemask_pd(_mm_cmple_pd(lo[0], hi[0])) |
-                         (_mm_movemask_pd(_mm_cmple_pd(lo[1], hi[1])) << 2);
-        return mask & used;
-    }
-#endif
-    int mask = 0;
-    for (int c = 0; c < 4; ++c) {
-        if (!(used & (1 << c))) continue;
-        const Box box{{b.lo[0][c], b.lo[1][c], b.lo[2][c]}, {b.hi[0][c], b.hi[1][c], b.hi[2][c]}};
-        double t1 = tmax;
-        t0[c] = tmin;
-        if (clipToBox(box, r, t0[c], t1)) mask |= 1 << c;
-    }
-    return mask;
-}
-
-}  // namespace
-
 // The first hit in a union's BVH: the nodes front to back by the ray's entry into them
 // (a stack of the ones still to visit, nearer ones on top), each skipped once its entry
 // lies beyond the nearest hit so far. (The order only saves work: a hit is the nearest
@@ -768,6 +745,9 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
     int top = 0;
     stack[top++] = {root, kNone, tmin};
     const uint64_t stamp = ++s.stamp;
+#if defined(__SSE2__)
+    const FloatRay fr = floatRay(r, tmin);
+#endif
     bool found = false;
     while (top > 0) {
         const Pending p = stack[--top];
@@ -785,7 +765,12 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
         }
         const BvhNode& b = bvh_[p.child];
         double t0[4];
+#if defined(__SSE2__)
+        int mask =
+            fr.ok ? enterChildrenFloat(b, fr, tmax, t0) : enterChildren(b, r, tmin, tmax, t0);
+#else
         int mask = enterChildren(b, r, tmin, tmax, t0);
+#endif
         // The children met, farthest pushed first (by insertion: at most four).
         const int base = top;
         for (; mask != 0; mask &= mask - 1) {

@@ -61,6 +61,10 @@ class UnrolledInstance {
         Kind kind;
         CsgOp op = CsgOp::Union;  // operators
         PrimitiveKind prim = PrimitiveKind::Empty;
+        // An operand of a BVH whose box there is the box of its box through a chain with
+        // rotations (looser than its own): the walk tests its own box, in the frame of
+        // the link's ray, before entering it.
+        bool looseInBvh = false;
         uint32_t material = kInherit;            // primitives: the innermost paint inside
         uint32_t firstMatrix = 0, matrices = 0;  // inverse matrices applied on entering
                                                  // (matrixRefs_[firstMatrix..])
@@ -76,7 +80,7 @@ class UnrolledInstance {
     // flower's 21 petals as a chain 21 unions deep). Spans still follow the derivation.
     // A node holds the boxes of up to four children side by side, in floats rounded
     // outwards (boxes only cull: a larger box never changes a hit), so that a node is two
-    // cache lines and SSE2 tests an axis of two children at a time; child c is another
+    // cache lines and one SSE register holds an axis of all four; child c is another
     // node (bvh_[child[c]]), or, with kLeaf set, an operand (nodes_[child[c] & ~kLeaf])
     // entered through the chain of matrices link[c] (links_; kNone: none) and then its
     // own, or kNone: an empty slot (after the used ones).
@@ -162,6 +166,8 @@ class UnrolledInstance {
     // the instance's nodes, in the order of the node's slots), node by node: which the
     // hierarchy groups together (tests).
     std::vector<std::vector<uint32_t>> bvhLeafGroups() const;
+    // The operands whose own box is tested before they are entered (Node::looseInBvh).
+    size_t looseOperands() const;
 
   private:
     friend class Unroller;

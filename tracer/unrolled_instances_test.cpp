@@ -316,17 +316,23 @@ C if(k < 15, 2, 1)
 2: C -> move(mod(k*5, 16), 0, 0) uscale(0.1) sphere ∪ {k = k+1} C
 )";
 
-// The widest spread of instance node indices among the operands of one hierarchy node
-// (siblings in the derivation are built one after the other: a spread of 3 for four).
-uint32_t widestGroup(const char* text) {
+// The expansion of the axiom's S-node instance of `text` (at depth 1), or nullptr.
+std::unique_ptr<UnrolledInstance> expandAxiom(const char* text) {
     auto c = compile(text);
     EXPECT_TRUE(c->graph);
-    if (!c->graph) return 0;
+    if (!c->graph) return nullptr;
     const Graph& g = *c->graph;
     TraceScene scene(g, computeBounds(g), true, eagerExpansion());
     auto [select, frame] = testing::axiomInstance(g);
-    const auto x = UnrolledInstance::expand(scene, select, 1, frame.data(), kRootPath, 1u << 20);
+    auto x = UnrolledInstance::expand(scene, select, 1, frame.data(), kRootPath, 1u << 20);
     EXPECT_TRUE(x);
+    return x;
+}
+
+// The widest spread of instance node indices among the operands of one hierarchy node
+// (siblings in the derivation are built one after the other: a spread of 3 for four).
+uint32_t widestGroup(const char* text) {
+    const auto x = expandAxiom(text);
     if (!x) return 0;
     uint32_t widest = 0, leaves = 0;
     for (const std::vector<uint32_t>& group : x->bvhLeafGroups()) {
@@ -350,6 +356,41 @@ TEST(ExpandedInstances, ABalancedDerivationIsTheHierarchyAndAChainIsSplit) {
         r.d.push_back(normalize(Vec3{0.01 * (i % 3), 1, 0.002 * (i % 5)}));
     }
     EXPECT_GT(compareWithGraphWalk(kNestedRow, r, 15), 0u);
+}
+
+// A binary tree five levels deep whose every branch is entered through four matrices
+// (parametric T-nodes: not fused), 20 in all from the root to a leaf, as a tree's crown.
+const char* kDeepChains = R"(
+{n = 5; s = 1; a = 50} T
+T if(n > 0, 2, 1)
+1: T -> uscale(0.6) sphere
+2: T -> {n = n-1; s = s*0.8; a = a*0.8}
+        (move(s, 0, 0.5) rotz(a) rotx(a*0.5) uscale(0.75) T ∪ move(-s, 0, 0.5) rotz(-a) roty(a*0.3) uscale(0.75) T)
+)";
+
+// Unions nested below chains of up to 20 matrices are one hierarchy over all 32 spheres
+// (a limit of 12 matrices cut it: 16 spheres in hierarchies, the others in unions of
+// their own), and hit the same surfaces as the walk.
+TEST(ExpandedInstances, UnionsBelowLongChainsOfMatricesAreOneHierarchy) {
+    const auto x = expandAxiom(kDeepChains);
+    ASSERT_TRUE(x);
+    size_t leaves = 0;
+    for (const std::vector<uint32_t>& group : x->bvhLeafGroups()) leaves += group.size();
+    EXPECT_EQ(leaves, 32u);
+    EXPECT_GT(compareWithGraphWalk(kDeepChains, 1.5, 100), 0u);
+}
+
+// Operands of a hierarchy whose box there is a box of their box through rotations test
+// their own box before they are entered (the spheres below kDeepChains' rotations);
+// below moves and scales (Sierpinski) the two are the same box, and none does.
+TEST(ExpandedInstances, OperandsBelowRotationsTestTheirOwnBoxes) {
+    const auto rotated = expandAxiom(kDeepChains);
+    ASSERT_TRUE(rotated);
+    EXPECT_EQ(rotated->looseOperands(), 32u);
+    const auto straight = expandAxiom(testing::kSierpinski);
+    ASSERT_TRUE(straight);
+    EXPECT_GT(straight->bvhNodes(), 0u);
+    EXPECT_EQ(straight->looseOperands(), 0u);
 }
 
 }  // namespace
