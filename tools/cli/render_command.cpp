@@ -124,6 +124,7 @@ struct RenderReport {
     std::unique_ptr<PngRows> png;
     size_t graphNodes = 0;
     double imageWriteSeconds = 0;            // writing the image file
+    bool rowsStreamed = false;               // the PNG's rows written while rendering
     std::optional<ImageWriteResult> helper;  // pcsg-image, for EXR and TIFF
 };
 
@@ -135,6 +136,7 @@ std::string writeOutput(const RenderCommandOptions& o, const std::string& imageH
     const std::span<const float> rgb = report.result.rgb;
     if (imageFormatOf(o.output) == ImageFormat::png) {
         try {
+            report.rowsStreamed = report.png != nullptr;
             if (report.png)
                 report.png->finish();
             else
@@ -695,8 +697,9 @@ void printText(const RenderCommandOptions& o, const RenderReport& report) {
                                  "image writer peak RSS", humanBytes(report.helper->peakRssBytes),
                                  kImageHelperName, report.imageWriteSeconds);
     else
-        std::cout << fmt::format("{:<24}{:.3f} s (libpng, in this process)\n", "image write time",
-                                 report.imageWriteSeconds);
+        std::cout << fmt::format(
+            "{:<24}{:.3f} s (libpng, {})\n", "image write time", report.imageWriteSeconds,
+            report.rowsStreamed ? "rows written while rendering" : "in this process");
     if (o.distributed) std::cout << rankFiguresText(o.distributed->finish(0));
 }
 

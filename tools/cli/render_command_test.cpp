@@ -146,6 +146,16 @@ TEST(RenderCommand, WritesAPngOfTheRightSize) {
     EXPECT_EQ(subreaper.leftovers(), 0);
 }
 
+// A still PNG's rows go into the file as the render finishes them, and the figures say so.
+TEST(RenderCommand, APngsRowsAreSaidToBeWrittenWhileRendering) {
+    TempDir dir;
+    const std::string scene = dir.write("s.pcsg", kScene);
+    const ChildResult r =
+        pcsg({"render", scene, "-o", dir.file("s.png"), "--width", "40", "--height", "30"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("(libpng, rows written while rendering)"), std::string::npos) << r.out;
+}
+
 TEST(RenderCommand, AnExrIsWrittenByTheHelperWhosePeakIsTheCommands) {
     Subreaper subreaper;
     TempDir dir;
