@@ -124,7 +124,6 @@ struct RenderReport {
     std::unique_ptr<PngRows> png;
     size_t graphNodes = 0;
     double imageWriteSeconds = 0;            // writing the image file
-    bool rowsStreamed = false;               // the PNG's rows written while rendering
     std::optional<ImageWriteResult> helper;  // pcsg-image, for EXR and TIFF
 };
 
@@ -136,7 +135,6 @@ std::string writeOutput(const RenderCommandOptions& o, const std::string& imageH
     const std::span<const float> rgb = report.result.rgb;
     if (imageFormatOf(o.output) == ImageFormat::png) {
         try {
-            report.rowsStreamed = report.png != nullptr;
             if (report.png)
                 report.png->finish();
             else
@@ -249,15 +247,6 @@ class FillCounts {
     std::shared_ptr<const KnownCounts> counts_;
 };
 
-// The count (primitive equivalence, and the scene's run-time errors on every path) runs on
-// a thread of its own beside the render. It waits for the render's instance-box fill,
-// which unrolls the instances below a few dozen S-node instances (a terrain's 2 million
-// triangles, which do not repeat and cannot be memoised) in parallel before the first
-// rays and counts them on the way: the count takes those counts and walks only the
-// levels above them, and what the fill could not count (a run-time error there, a part
-// found stored) itself. What is reported stays the serial order's: an error of the count
-// wins over the render's (the render is cancelled and its pixels dropped), then the
-// render's own error; nothing is written unless both succeed.
 // Opens the PNG the render's rows go to (RenderReport::png): 2 with the error printed
 // when it cannot be written.
 int openPng(const RenderCommandOptions& o, RenderReport& report, const std::string& frameNote) {
@@ -271,21 +260,17 @@ int openPng(const RenderCommandOptions& o, RenderReport& report, const std::stri
     return 0;
 }
 
-// Where the render's rows go: into the PNG as they are finished (the image is never held
-// whole: 3.7 MB of floats at 640x480), or, for the helper's formats, into `floats`.
-tracer::RowSink outputRows(const RenderCommandOptions& o, RenderReport& report,
-                           std::vector<float>& floats) {
-    if (report.png)
-        return [png = report.png.get()](int y, std::span<const float> rgb) { png->put(y, rgb); };
-    const size_t row = static_cast<size_t>(o.width) * 3;
-    floats.resize(row * o.height);
-    return [&floats, row](int y, std::span<const float> rgb) {
-        std::copy(rgb.begin(), rgb.end(), floats.begin() + y * row);
-    };
-}
-
+// The count (primitive equivalence, and the scene's run-time errors on every path) runs on
+// a thread of its own beside the render. It waits for the render's instance-box fill,
+// which unrolls the instances below a few dozen S-node instances (a terrain's 2 million
+// triangles, which do not repeat and cannot be memoised) in parallel before the first
+// rays and counts them on the way: the count takes those counts and walks only the
+// levels above them, and what the fill could not count (a run-time error there, a part
+// found stored) itself. What is reported stays the serial order's: an error of the count
+// wins over the render's (the render is cancelled and its pixels dropped), then the
+// render's own error; nothing is written unless both succeed.
 void countBesideRender(const Graph& g, CountOptions co, tracer::RenderOptions ro,
-                       const tracer::RowSink& rows, RenderReport& report) {
+                       RenderReport& report) {
     std::atomic<bool> cancel{false};
     if (ro.cancel) throw std::logic_error("countBesideRender: the render has its own cancel flag");
     ro.cancel = &cancel;
@@ -305,7 +290,13 @@ void countBesideRender(const Graph& g, CountOptions co, tracer::RenderOptions ro
         }
     });
     try {
-        report.result = tracer::render(g, ro, rows);
+        // A PNG gets the rows as they are finished (the image is never held whole: 3.7 MB
+        // of floats at 640x480); the helper's formats get result.rgb.
+        if (PngRows* png = report.png.get())
+            report.result = tracer::render(
+                g, ro, [png](int y, std::span<const float> rgb) { png->put(y, rgb); });
+        else
+            report.result = tracer::render(g, ro);
     } catch (...) {
         renderError = std::current_exception();
     }
@@ -344,9 +335,7 @@ int countAndRender(Graph& g, const RenderCommandOptions& o, RenderReport& report
     try {
         CountOptions co;
         co.maxVisits = o.countVisits;
-        std::vector<float> floats;
-        countBesideRender(g, co, ro, outputRows(o, report, floats), report);
-        report.result.rgb = std::move(floats);
+        countBesideRender(g, co, ro, report);
     } catch (const RuntimeError& e) {
         if (showProgress) bar->finish();
         std::cerr << e.format(g) << frameNote << "\n";
@@ -697,9 +686,9 @@ void printText(const RenderCommandOptions& o, const RenderReport& report) {
                                  "image writer peak RSS", humanBytes(report.helper->peakRssBytes),
                                  kImageHelperName, report.imageWriteSeconds);
     else
-        std::cout << fmt::format(
-            "{:<24}{:.3f} s (libpng, {})\n", "image write time", report.imageWriteSeconds,
-            report.rowsStreamed ? "rows written while rendering" : "in this process");
+        std::cout << fmt::format("{:<24}{:.3f} s (libpng, {})\n", "image write time",
+                                 report.imageWriteSeconds,
+                                 report.png ? "rows written while rendering" : "in this process");
     if (o.distributed) std::cout << rankFiguresText(o.distributed->finish(0));
 }
 
@@ -780,7 +769,6 @@ int runStill(const RenderCommandOptions& o, CompiledScene& compiled,
         return 2;
     }
     report.result.rgb = std::vector<float>();  // written: the printing needs only the figures
-    report.png.reset();
     report.graphNodes = g.nodes.size();
     Stats& s = report.stats;
     s.scene = o.scene;
