@@ -155,7 +155,7 @@ StepMemo::StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog
       plan_(plan),
       stride_(kKey + plan.maxReads() + plan.maxWrites()),
       table_(stride_ << entriesLog2Within(stride_, entriesLog2)),
-      mask_((1u << entriesLog2Within(stride_, entriesLog2)) - 1) {
+      mask_(static_cast<uint32_t>(table_.size() / stride_) - 1) {
     for (size_t i = 0; i < table_.size(); i += stride_) table_[i] = kNone;
 }
 
