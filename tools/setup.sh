@@ -18,7 +18,7 @@ fi
 
 PACKAGES=(build-essential cmake ninja-build pkg-config libfmt-dev libcli11-dev libpng-dev
           nlohmann-json3-dev libopenimageio-dev openimageio-tools libtbb-dev libgtest-dev
-          libgmock-dev libbenchmark-dev libembree-dev povray graphviz clang clang-format chromium python3 ffmpeg
+          libgmock-dev libbenchmark-dev libembree-dev povray graphviz clang clang-format lld chromium python3 ffmpeg
           openmpi-bin libopenmpi-dev)
 BUILD=build              # the binaryDir of the "release" preset in CMakePresets.json
 PCSG=$BUILD/tools/pcsg
