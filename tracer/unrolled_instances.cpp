@@ -685,8 +685,12 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             break;
         }
         case Kind::Instance: {
-            const Reference& x = instances_[node.first];
-            found = x.instance->first(rr, tmin, tmax, hit, {x.path, material, paint}, anyHit, s);
+            // first() without its clip to the instance's box: this node's box, which holds
+            // it, has been met (boxes only cull), and first() on the top level has sized
+            // s.linked for the instances too.
+            const UnrolledInstance& x = *instances_[node.first].instance;
+            const Use inside{instances_[node.first].path, material, paint};
+            found = x.root_ != kNone && x.firstAt(x.root_, rr, tmin, tmax, hit, inside, anyHit, s);
             break;
         }
         case Kind::Operator:
