@@ -738,16 +738,18 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
 // (t, key) of all operands whose boxes the ray meets before it, whatever the order.)
 bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax,
                                 Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
-    struct Pending {
+    // (the entries in floats: the float test's own, and the doubles' rounded down, so
+    // that an entry is never later than the doubles'; 16 bytes, moved as one)
+    struct alignas(16) Pending {
         uint32_t child, link;
-        double t0;
+        float t0;
     };
     // Deeper than any hierarchy of median splits, or of a derivation's nesting (hierarchy():
     // at most one level deeper), with four entries per level at most.
     constexpr int kStack = 4 * 32 + 4;
     Pending stack[kStack];
     int top = 0;
-    stack[top++] = {root, kNone, tmin};
+    stack[top++] = {root, kNone, floatBelow(tmin)};
     const uint64_t stamp = ++s.stamp;
 #if defined(__SSE2__)
     const FloatRay fr = floatRay(r, tmin);
@@ -768,12 +770,12 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
             continue;
         }
         const BvhNode& b = bvh_[p.child];
-        double t0[4];
+        float t0[4];
 #if defined(__SSE2__)
         int mask =
-            fr.ok ? enterChildrenFloat(b, fr, tmax, t0) : enterChildren(b, r, tmin, tmax, t0);
+            fr.ok ? enterChildrenFloat(b, fr, tmax, t0) : enterChildrenBelow(b, r, tmin, tmax, t0);
 #else
-        int mask = enterChildren(b, r, tmin, tmax, t0);
+        int mask = enterChildrenBelow(b, r, tmin, tmax, t0);
 #endif
         // The children met, farthest pushed first (by insertion: at most four).
         const int base = top;
