@@ -777,12 +777,14 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
 #else
         int mask = enterChildrenBelow(b, r, tmin, tmax, t0);
 #endif
-        // The children met, farthest pushed first (by insertion: at most four).
+        // The children met, farthest pushed first (by insertion: at most four) for a first
+        // hit.
         const int base = top;
         for (; mask != 0; mask &= mask - 1) {
             const int c = __builtin_ctz(static_cast<unsigned>(mask));
             int k = top++;
-            for (; k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
+            // (a shadow ray may stop at any surface: its children unsorted)
+            for (; !anyHit && k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
             stack[k] = {b.child[c], b.link[c], t0[c]};
         }
     }
