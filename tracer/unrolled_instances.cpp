@@ -11,6 +11,7 @@
 #include "bounds.h"
 #include "bvh_slabs.h"
 #include "eval.h"
+#include "eval_core.h"
 #include "flat_index.h"
 #include "outward_float.h"
 #include "traversal.h"
@@ -613,10 +614,11 @@ const LocalRay& UnrolledInstance::linkedRay(uint32_t l, const LocalRay& r, uint6
     return e.ray;
 }
 
+// (the mixers inline: a hit replays a dozen choices)
 uint64_t UnrolledInstance::keyOf(const Node& node, uint64_t path) const {
     for (uint32_t k = 0; k < node.choices; ++k) {
         const uint32_t c = choices_[node.firstChoice + k];
-        path = (c & kRuleBit) ? pathRule(path, c & ~kRuleBit) : pathChild(path, c);
+        path = (c & kRuleBit) ? pathRuleInline(path, c & ~kRuleBit) : pathChildInline(path, c);
     }
     return path;
 }
