@@ -68,10 +68,10 @@ std::string describeFrame(const Graph& g, const double* frame) {
 // Instance paths and randomness.
 
 uint64_t pathChild(uint64_t path, uint32_t childIndex) {
-    return mix64(path ^ (0x6a09e667f3bcc908ULL + (static_cast<uint64_t>(childIndex) << 1)));
+    return pathChildInline(path, childIndex);
 }
 uint64_t pathRule(uint64_t path, uint32_t ruleIndex) {
-    return mix64(path ^ (0xbb67ae8584caa73bULL + (static_cast<uint64_t>(ruleIndex) << 1)));
+    return pathRuleInline(path, ruleIndex);
 }
 
 double randOf(uint64_t seed, double x) {

@@ -1,6 +1,7 @@
 // What the plain stack machine (eval.cpp) and the fast machine (fast_eval.cpp) share, so
 // that both compute every value with the same code: the functions of the language, the
-// mixers behind rand(), the pick of choose(). Internal to the compiler library.
+// mixers behind rand(), the pick of choose(). Internal to the compiler library, but for
+// the instance path's mixers, which the tracer's expanded instances inline too.
 #pragma once
 
 #include <bit>
@@ -26,6 +27,14 @@ constexpr uint64_t mix64(uint64_t z) {
 }
 constexpr double toUnit(uint64_t h) {
     return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+// The instance path's steps (eval.h's pathChild and pathRule), inline.
+inline uint64_t pathChildInline(uint64_t path, uint32_t childIndex) {
+    return mix64(path ^ (0x6a09e667f3bcc908ULL + (static_cast<uint64_t>(childIndex) << 1)));
+}
+inline uint64_t pathRuleInline(uint64_t path, uint32_t ruleIndex) {
+    return mix64(path ^ (0xbb67ae8584caa73bULL + (static_cast<uint64_t>(ruleIndex) << 1)));
 }
 
 // rand(x) and rand() (eval.h's randOf and randAt), inline for the machines' loops.

@@ -26,6 +26,7 @@
 #endif
 
 #include "operators.h"
+#include "outward_float.h"
 #include "unrolled_instances.h"
 
 namespace pcsg::tracer {
@@ -73,15 +74,27 @@ inline int enterChildren(const UnrolledInstance::BvhNode& b, const LocalRay& r, 
     return mask;
 }
 
+// enterChildren with the entries rounded down to floats (at most the doubles').
+inline int enterChildrenBelow(const UnrolledInstance::BvhNode& b, const LocalRay& r, double tmin,
+                              double tmax, float t0[4]) {
+    double t[4];
+    const int mask = enterChildren(b, r, tmin, tmax, t);
+    for (int c = 0; c < 4; ++c) t0[c] = floatBelow(t[c]);
+    return mask;
+}
+
 #if defined(__SSE2__)
 
 // A ray in floats for enterChildrenFloat, made once per walk of a hierarchy: `ok` only
 // where the float test's error bound holds (no zero axis; the float origin and 1/d with
 // |o| < 2^60 and 2^-60 < |1/d| < 2^60, so that no float product is a NaN and the margin
-// is finite), else the walk takes enterChildren.
+// is finite), else the walk takes enterChildren. It carries the widening's constants
+// (kFloatSlabs) too: the walk keeps them beside the ray, operands of the test's
+// instructions, instead of broadcasting each from a scalar at every node.
 struct FloatRay {
     __m128 o[3], inv[3];
     __m128 tmin, margin;
+    __m128 down, up, max, lowest;
     bool ok = false;
 };
 
@@ -128,6 +141,9 @@ inline FloatRay floatRay(const LocalRay& r, double tmin) {
     f.inv[1] = _mm_shuffle_ps(iv, iv, 0x55);
     f.inv[2] = _mm_shuffle_ps(iv, iv, 0xaa);
     f.tmin = _mm_set1_ps(static_cast<float>(tmin));
+    const FloatSlabConstants& k = kFloatSlabs;
+    f.down = _mm_load_ps(k.down), f.up = _mm_load_ps(k.up);
+    f.max = _mm_load_ps(k.max), f.lowest = _mm_load_ps(k.lowest);
     f.ok = true;
     return f;
 }
@@ -137,7 +153,7 @@ inline FloatRay floatRay(const LocalRay& r, double tmin) {
 // the widened entries stay below FLT_MAX and the exits above -FLT_MAX (a float that
 // overflows is then still on the right side of a double that does not).
 inline int enterChildrenFloat(const UnrolledInstance::BvhNode& b, const FloatRay& f, double tmax,
-                              double t0[4]) {
+                              float t0[4]) {
     __m128 lo = f.tmin, hi = _mm_set1_ps(static_cast<float>(tmax));
     for (int a = 0; a < 3; ++a) {
         const __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(b.lo[a]), f.o[a]), f.inv[a]);
@@ -145,18 +161,24 @@ inline int enterChildrenFloat(const UnrolledInstance::BvhNode& b, const FloatRay
         lo = _mm_max_ps(_mm_min_ps(y, x), lo);
         hi = _mm_min_ps(_mm_max_ps(x, y), hi);
     }
-    const FloatSlabConstants& k = kFloatSlabs;
-    const __m128 down = _mm_load_ps(k.down), up = _mm_load_ps(k.up);
-    lo = _mm_sub_ps(_mm_min_ps(_mm_mul_ps(lo, down), _mm_mul_ps(lo, up)), f.margin);
-    hi = _mm_add_ps(_mm_max_ps(_mm_mul_ps(hi, down), _mm_mul_ps(hi, up)), f.margin);
-    lo = _mm_min_ps(lo, _mm_load_ps(k.max));
-    hi = _mm_max_ps(hi, _mm_load_ps(k.lowest));
-    _mm_storeu_pd(t0, _mm_cvtps_pd(lo));
-    _mm_storeu_pd(t0 + 2, _mm_cvtps_pd(_mm_movehl_ps(lo, lo)));
+    lo = _mm_sub_ps(_mm_min_ps(_mm_mul_ps(lo, f.down), _mm_mul_ps(lo, f.up)), f.margin);
+    hi = _mm_add_ps(_mm_max_ps(_mm_mul_ps(hi, f.down), _mm_mul_ps(hi, f.up)), f.margin);
+    lo = _mm_min_ps(lo, f.max);
+    hi = _mm_max_ps(hi, f.lowest);
+    _mm_storeu_ps(t0, lo);
     const __m128i empty = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(b.child)),
                                           _mm_set1_epi32(-1));
     const int used = ~_mm_movemask_ps(_mm_castsi128_ps(empty)) & 15;
     return _mm_movemask_ps(_mm_cmple_ps(lo, hi)) & used;
+}
+
+// The same with the entries in doubles (the floats' values).
+inline int enterChildrenFloat(const UnrolledInstance::BvhNode& b, const FloatRay& f, double tmax,
+                              double t0[4]) {
+    float t[4];
+    const int mask = enterChildrenFloat(b, f, tmax, t);
+    for (int c = 0; c < 4; ++c) t0[c] = t[c];
+    return mask;
 }
 
 #endif

@@ -11,6 +11,7 @@
 #include "bounds.h"
 #include "bvh_slabs.h"
 #include "eval.h"
+#include "eval_core.h"
 #include "flat_index.h"
 #include "outward_float.h"
 #include "traversal.h"
@@ -613,10 +614,11 @@ const LocalRay& UnrolledInstance::linkedRay(uint32_t l, const LocalRay& r, uint6
     return e.ray;
 }
 
+// (the mixers inline: a hit replays a dozen choices)
 uint64_t UnrolledInstance::keyOf(const Node& node, uint64_t path) const {
     for (uint32_t k = 0; k < node.choices; ++k) {
         const uint32_t c = choices_[node.firstChoice + k];
-        path = (c & kRuleBit) ? pathRule(path, c & ~kRuleBit) : pathChild(path, c);
+        path = (c & kRuleBit) ? pathRuleInline(path, c & ~kRuleBit) : pathChildInline(path, c);
     }
     return path;
 }
@@ -685,8 +687,12 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             break;
         }
         case Kind::Instance: {
-            const Reference& x = instances_[node.first];
-            found = x.instance->first(rr, tmin, tmax, hit, {x.path, material, paint}, anyHit, s);
+            // first() without its clip to the instance's box: this node's box, which holds
+            // it, has been met (boxes only cull), and first() on the top level has sized
+            // s.linked for the instances too.
+            const UnrolledInstance& x = *instances_[node.first].instance;
+            const Use inside{instances_[node.first].path, material, paint};
+            found = x.root_ != kNone && x.firstAt(x.root_, rr, tmin, tmax, hit, inside, anyHit, s);
             break;
         }
         case Kind::Operator:
@@ -734,16 +740,18 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
 // (t, key) of all operands whose boxes the ray meets before it, whatever the order.)
 bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax,
                                 Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
-    struct Pending {
+    // (the entries in floats: the float test's own, and the doubles' rounded down, so
+    // that an entry is never later than the doubles'; 16 bytes, moved as one)
+    struct alignas(16) Pending {
         uint32_t child, link;
-        double t0;
+        float t0;
     };
     // Deeper than any hierarchy of median splits, or of a derivation's nesting (hierarchy():
     // at most one level deeper), with four entries per level at most.
     constexpr int kStack = 4 * 32 + 4;
     Pending stack[kStack];
     int top = 0;
-    stack[top++] = {root, kNone, tmin};
+    stack[top++] = {root, kNone, floatBelow(tmin)};
     const uint64_t stamp = ++s.stamp;
 #if defined(__SSE2__)
     const FloatRay fr = floatRay(r, tmin);
@@ -764,19 +772,21 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
             continue;
         }
         const BvhNode& b = bvh_[p.child];
-        double t0[4];
+        float t0[4];
 #if defined(__SSE2__)
         int mask =
-            fr.ok ? enterChildrenFloat(b, fr, tmax, t0) : enterChildren(b, r, tmin, tmax, t0);
+            fr.ok ? enterChildrenFloat(b, fr, tmax, t0) : enterChildrenBelow(b, r, tmin, tmax, t0);
 #else
-        int mask = enterChildren(b, r, tmin, tmax, t0);
+        int mask = enterChildrenBelow(b, r, tmin, tmax, t0);
 #endif
-        // The children met, farthest pushed first (by insertion: at most four).
+        // The children met, farthest pushed first (by insertion: at most four) for a first
+        // hit.
         const int base = top;
         for (; mask != 0; mask &= mask - 1) {
             const int c = __builtin_ctz(static_cast<unsigned>(mask));
             int k = top++;
-            for (; k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
+            // (a shadow ray may stop at any surface: its children unsorted)
+            for (; !anyHit && k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
             stack[k] = {b.child[c], b.link[c], t0[c]};
         }
     }
