@@ -214,20 +214,9 @@ uint32_t translateCalc(Graph& g, const Calc& c) {
     return start;
 }
 
-constexpr const char* kOpNames[] = {
-    "PushK", "PushL", "PushClock", "PushFrame", "PushRand0", "Neg",        "Not",   "ToBool",
-    "Sin",   "Cos",   "Tan",       "Asin",      "Acos",      "Atan",       "Sqrt",  "Exp",
-    "Ln",    "Log10", "Abs",       "Floor",     "Ceil",      "Rand1",      "Add",   "Sub",
-    "Mul",   "Div",   "Mod",       "Pow",       "Lt",        "Le",         "Gt",    "Ge",
-    "Eq",    "Ne",    "AddK",      "SubK",      "MulK",      "DivK",       "ModK",  "PowK",
-    "LtK",   "LeK",   "GtK",       "GeK",       "EqK",       "NeK",        "AddL",  "SubL",
-    "MulL",  "DivL",  "ModL",      "PowL",      "LtL",       "LeL",        "GtL",   "GeL",
-    "EqL",   "NeL",   "AddKL",     "SubKL",     "MulKL",     "DivKL",      "ModKL", "PowKL",
-    "LtKL",  "LeKL",  "GtKL",      "GeKL",      "EqKL",      "NeKL",       "AddLK", "SubLK",
-    "MulLK", "DivLK", "ModLK",     "PowLK",     "LtLK",      "LeLK",       "GtLK",  "GeLK",
-    "EqLK",  "NeLK",  "Call",      "Choose",    "Jump",      "JumpIfZero", "Store", "StoreKeep",
-    "End",
-};
+#define PCSG_FAST_NAME(name) #name,
+constexpr const char* kOpNames[] = {PCSG_FAST_OPS(PCSG_FAST_NAME)};
+#undef PCSG_FAST_NAME
 static_assert(std::size(kOpNames) == static_cast<size_t>(FastOp::End) + 1);
 
 std::string slotName(const Graph& g, uint32_t s) {

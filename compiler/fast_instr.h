@@ -18,105 +18,45 @@
 
 namespace pcsg {
 
-enum class FastOp : uint8_t {
-    // leaves: spill acc, then acc = the value
-    PushK,      // imm
-    PushL,      // frame[a]; an unassigned slot stops the fast run (the plain code throws)
-    PushClock,  // the graph's time
-    PushFrame,
-    PushRand0,  // rand() at call site a
-    // acc = f(acc)
-    Neg,
-    Not,
-    ToBool,
-    Sin,
-    Cos,
-    Tan,
-    Asin,
-    Acos,
-    Atan,
-    Sqrt,
-    Exp,
-    Ln,
-    Log10,
-    Abs,
-    Floor,
-    Ceil,
-    Rand1,
-    // acc = (popped) op acc
-    Add,
-    Sub,
-    Mul,
-    Div,
-    Mod,
-    Pow,
-    Lt,
-    Le,
-    Gt,
-    Ge,
-    Eq,
-    Ne,
-    // acc = acc op imm
-    AddK,
-    SubK,
-    MulK,
-    DivK,
-    ModK,
-    PowK,
-    LtK,
-    LeK,
-    GtK,
-    GeK,
-    EqK,
-    NeK,
-    // acc = acc op frame[a] (checked as PushL)
-    AddL,
-    SubL,
-    MulL,
-    DivL,
-    ModL,
-    PowL,
-    LtL,
-    LeL,
-    GtL,
-    GeL,
-    EqL,
-    NeL,
-    // spill acc, then acc = imm op frame[a] (checked as PushL)
-    AddKL,
-    SubKL,
-    MulKL,
-    DivKL,
-    ModKL,
-    PowKL,
-    LtKL,
-    LeKL,
-    GtKL,
-    GeKL,
-    EqKL,
-    NeKL,
-    // spill acc, then acc = frame[a] op imm (checked as PushL)
-    AddLK,
-    SubLK,
-    MulLK,
-    DivLK,
-    ModLK,
-    PowLK,
-    LtLK,
-    LeLK,
-    GtLK,
-    GeLK,
-    EqLK,
-    NeLK,
-    // argc values (acc the last): acc = Func a of them / choose() at call site a
-    Call,
-    Choose,
-    Jump,        // pc = a (absolute index into Graph::fastCode)
-    JumpIfZero,  // v = acc, pop; if v == 0, pc = a
-    Store,       // out[a] = acc, pop (a C-node's assignment)
-    StoreKeep,   // out[a] = acc, kept: Store a then PushL a where the frame is `out`
-    End,         // the value is acc
-};
+// The operations, in the order of FastOp's values: X(name) each. The one list makes the
+// enum, the names fast_code.cpp prints and the dispatch table of the machine (fast_eval.cpp),
+// so that the three cannot fall out of step.
+// clang-format off
+#define PCSG_FAST_COMPARISONS(X, FORM) \
+    X(Lt##FORM) X(Le##FORM) X(Gt##FORM) X(Ge##FORM) X(Eq##FORM) X(Ne##FORM)
+#define PCSG_FAST_OPS(X)                                                                    \
+    /* leaves: spill acc, then acc = the value */                                         \
+    X(PushK)     /* imm */                                                                \
+    X(PushL)     /* frame[a]; an unassigned slot stops the fast run (the plain code throws) */ \
+    X(PushClock) /* the graph's time */                                                   \
+    X(PushFrame)                                                                          \
+    X(PushRand0) /* rand() at call site a */                                              \
+    /* acc = f(acc) */                                                                    \
+    X(Neg) X(Not) X(ToBool) X(Sin) X(Cos) X(Tan) X(Asin) X(Acos) X(Atan) X(Sqrt) X(Exp)   \
+    X(Ln) X(Log10) X(Abs) X(Floor) X(Ceil) X(Rand1)                                       \
+    /* acc = (popped) op acc */                                                           \
+    X(Add) X(Sub) X(Mul) X(Div) X(Mod) X(Pow) PCSG_FAST_COMPARISONS(X, )                  \
+    /* acc = acc op imm */                                                                \
+    X(AddK) X(SubK) X(MulK) X(DivK) X(ModK) X(PowK) PCSG_FAST_COMPARISONS(X, K)           \
+    /* acc = acc op frame[a] (checked as PushL) */                                        \
+    X(AddL) X(SubL) X(MulL) X(DivL) X(ModL) X(PowL) PCSG_FAST_COMPARISONS(X, L)           \
+    /* spill acc, then acc = imm op frame[a] (checked as PushL) */                        \
+    X(AddKL) X(SubKL) X(MulKL) X(DivKL) X(ModKL) X(PowKL) PCSG_FAST_COMPARISONS(X, KL)    \
+    /* spill acc, then acc = frame[a] op imm (checked as PushL) */                        \
+    X(AddLK) X(SubLK) X(MulLK) X(DivLK) X(ModLK) X(PowLK) PCSG_FAST_COMPARISONS(X, LK)    \
+    /* argc values (acc the last): acc = Func a of them / choose() at call site a */      \
+    X(Call)                                                                               \
+    X(Choose)                                                                             \
+    X(Jump)       /* pc = a (absolute index into Graph::fastCode) */                      \
+    X(JumpIfZero) /* v = acc, pop; if v == 0, pc = a */                                   \
+    X(Store)      /* out[a] = acc, pop (a C-node's assignment) */                         \
+    X(StoreKeep)  /* out[a] = acc, kept: Store a then PushL a where the frame is `out` */ \
+    X(End)        /* the value is acc */
+// clang-format on
+
+#define PCSG_FAST_ENUMERATOR(name) name,
+enum class FastOp : uint8_t { PCSG_FAST_OPS(PCSG_FAST_ENUMERATOR) };
+#undef PCSG_FAST_ENUMERATOR
 
 struct FastInstr {
     FastOp op = FastOp::End;
