@@ -929,8 +929,8 @@ void addRenderCommand(CLI::App& app, int& status) {
     cmd->add_option("--expansion-cache-mb", o->expansionCacheMb,
                     "Memory limit in MB of the cache of expanded sub-graph instances, shared "
                     "by all threads (small instances unrolled once and traced as flat arrays; "
-                    "its budget starts at 2 MB and grows to this limit as far as its "
-                    "instances are met again after eviction; 0: none; the image is the same)")
+                    "its budget starts at 2 MB and grows toward this limit where a larger "
+                    "one saves expansions; 0: none; the image is the same)")
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--count-visits", o->countVisits,
