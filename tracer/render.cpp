@@ -530,6 +530,7 @@ RenderResult RegionRenderer::figures() const {
             r.expansions += wp->shader.tracer().expansions();
         }
     if (s.scene.instanceBoxes()) r.instanceBoxes = s.scene.instanceBoxes()->stats();
+    r.expansionBudget = s.scene.expansionBudget();
     return r;
 }
 

@@ -110,6 +110,7 @@ struct RenderResult {
     uint32_t infiniteBoxes = 0;      // nodes left with unbounded boxes
     InstanceBoxStats instanceBoxes;  // the instance-box cache at the end
     uint64_t expansions = 0;         // sub-graph instances expanded (all threads)
+    size_t expansionBudget = 0;      // the bytes the expansion cache's budget grew to
 };
 
 // Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)

@@ -195,6 +195,10 @@ UnrollCache& TraceScene::expansionCache() const {
     return *expansionCache_;
 }
 
+size_t TraceScene::expansionBudget() const {
+    return expansionCache_ ? expansionCache_->budget() : 0;
+}
+
 const TopLevel* TraceScene::buildTopLevel(uint32_t maxTries) const {
     if (const TopLevel* t = topLevel()) return t;
     if (!useBounds || !instanceBoxes_ || expansionBytes == 0 || !twoLevel) return nullptr;

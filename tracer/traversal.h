@@ -113,6 +113,9 @@ class TraceScene {
     size_t expansionBytes = 16u << 20;
     // That cache, made by the first tracer that asks for it (with expansionBytes then).
     UnrollCache& expansionCache() const;
+    // The budget that cache reached (it starts small and grows, unroll_cache.h); 0 if
+    // it was never made.
+    size_t expansionBudget() const;
 
     // Each tracer remembers the results of C- and T-steps (compiler/step_memo.h) in a table
     // of 2^stepMemoLog2 entries (of 336 bytes); 0 turns it off.

@@ -28,6 +28,13 @@ constexpr uint64_t kTrial = 64, kUses = 4;
 // rebuilds of evicted instances, the level thrashes.
 constexpr size_t kShare = 8, kLarge = 64;
 constexpr uint64_t kRebuilds = 3;
+// A level whose instances are too large for the budget reached (not for the maximum) gets
+// the budget it needs once they have been met kMisses times and kStandIns expansions at
+// other levels stood in for them: a tree whose levels are one instance each is served by
+// one smaller expansion below (and the top level's copies of it), and stays small; one whose
+// smaller instances are many and distinct (a tree whose branches sway each in its own way)
+// gains from the larger ones.
+constexpr uint64_t kMisses = 256, kStandIns = 4;
 // The bytes per node visit of an expansion: the estimate before the first one, and the
 // fewest, which bounds the visits of one (an expansion that reaches the limit is refused).
 constexpr double kFirstBytesPerVisit = 64;
@@ -41,7 +48,7 @@ struct UnrollCache::Entry {
     std::atomic<bool> referenced{false};               // used since the eviction hand passed
     std::shared_ptr<const UnrolledInstance> instance;  // Built (shared with a top level)
     size_t bytes = kNoteBytes;
-    bool evicted = false;  // a note left by an instance that was built and evicted
+    size_t ghost = 0;  // a note left by an instance that was built and evicted: its bytes
 };
 
 struct alignas(64) UnrollCache::Shard {
@@ -53,11 +60,21 @@ struct UnrollCache::Yield {
     std::atomic<uint64_t> built{0}, used{0}, rebuilt{0}, refused{0};
     std::atomic<uint64_t> largeBytes{0};  // of the large instances built
     std::atomic<bool> off{false};
+    // The budget at which its instances were predicted too large (0: never): they are tried
+    // again once the budget has grown past it.
+    std::atomic<size_t> tooLargeAt{0};
+    std::atomic<size_t> want{0};      // the bytes of such an instance (predicted or built)
+    std::atomic<uint64_t> missed{0};  // meetings of its instances since
+    bool skipped(size_t budget) const {
+        return off.load(std::memory_order_relaxed) ||
+               tooLargeAt.load(std::memory_order_relaxed) >= budget;
+    }
 };
 
-UnrollCache::UnrollCache(const TraceScene& scene, size_t maxBytes)
+UnrollCache::UnrollCache(const TraceScene& scene, size_t maxBytes, size_t startBytes)
     : scene_(scene),
       maxBytes_(maxBytes),
+      budget_(std::min(maxBytes, startBytes)),
       levels_(scene.graph().scene.settings.maxDepth + 2),
       shards_(std::make_unique<Shard[]>(kShards)),
       yield_(std::make_unique<Yield[]>(scene.graph().modules.size() * levels_)) {}
@@ -69,7 +86,31 @@ UnrollCache::Shard& UnrollCache::shardOf(const InstanceBoxes::Key& k) const {
 }
 
 size_t UnrollCache::maxInstanceBytes() const {
-    return maxBytes_ / kShare;
+    return budget() / kShare;
+}
+
+// Grows the budget by `bytes` (an evicted instance met again), up to the maximum; false
+// when it is at the maximum already.
+// An evicted instance's ghost is being expanded again (under its shard's write lock).
+void UnrollCache::unghost(Entry& e) {
+    ghostBytes_.fetch_sub(e.ghost, std::memory_order_relaxed);
+    e.ghost = 0;
+}
+
+// Grows the budget to `bytes` (at most the maximum), if it is less.
+void UnrollCache::growTo(size_t bytes) {
+    size_t b = budget();
+    const size_t want = std::min(maxBytes_, bytes);
+    while (b < want && !budget_.compare_exchange_weak(b, want, std::memory_order_relaxed)) {
+    }
+}
+
+bool UnrollCache::grow(size_t bytes) {
+    size_t b = budget();
+    while (b < maxBytes_ && !budget_.compare_exchange_weak(b, std::min(maxBytes_, b + bytes),
+                                                           std::memory_order_relaxed)) {
+    }
+    return b < maxBytes_;
 }
 
 UnrollCache::Level UnrollCache::level(NodeId select, uint32_t depth) const {
@@ -92,7 +133,7 @@ void UnrollCache::evict() {
     {
         std::lock_guard<std::mutex> hand(queueMutex_);
         for (size_t turns = 2 * queue_.size(); turns > 0 && !queue_.empty(); --turns) {
-            if (bytes_.load(std::memory_order_relaxed) <= maxBytes_) break;
+            if (bytes_.load(std::memory_order_relaxed) <= budget()) break;
             const InstanceBoxes::Key k = queue_.front();
             queue_.pop_front();
             Shard& s = shardOf(k);
@@ -105,16 +146,24 @@ void UnrollCache::evict() {
                 queue_.push_back(k);
                 continue;
             }
-            if (e.instance) {  // leaves a note behind (a later expansion is a rebuild)
+            if (e.instance) {  // leaves a ghost behind (a later expansion is a rebuild)
                 freed += e.bytes;
                 out.push_back(std::move(e.instance));
-                bytes_.fetch_sub(e.bytes - kNoteBytes, std::memory_order_relaxed);
-                e.bytes = kNoteBytes;
+                bytes_.fetch_sub(e.bytes, std::memory_order_relaxed);
+                ghostBytes_.fetch_add(e.ghost = e.bytes, std::memory_order_relaxed);
+                e.bytes = 0;  // (a ghost's few bytes are not counted)
                 e.state = Entry::State::Note;
-                e.evicted = true;
                 e.referenced.store(true, std::memory_order_relaxed);  // (a second round)
                 queue_.push_back(k);
                 continue;
+            }
+            if (e.ghost > 0 && e.state == Entry::State::Note) {
+                // Ghosts stay while they are no more than the budget could still grow by.
+                if (ghostBytes_.load(std::memory_order_relaxed) <= maxBytes_ - budget()) {
+                    queue_.push_back(k);
+                    continue;
+                }
+                ghostBytes_.fetch_sub(e.ghost, std::memory_order_relaxed);
             }
             bytes_.fetch_sub(e.bytes, std::memory_order_relaxed);
             entries_.fetch_sub(1, std::memory_order_relaxed);
@@ -130,7 +179,8 @@ void UnrollCache::evict() {
 UnrollCache::Reader::Reader(UnrollCache& cache)
     : cache_(cache),
       slot_(cache.retired_.join()),
-      uses_(cache.scene_.graph().modules.size() * cache.levels_, 0) {}
+      uses_(cache.scene_.graph().modules.size() * cache.levels_, 0),
+      misses_(uses_.size(), 0) {}
 
 UnrollCache::Reader::~Reader() {
     for (size_t y = 0; y < uses_.size(); ++y)
@@ -144,11 +194,23 @@ void UnrollCache::Reader::used(size_t y) {
     uses_[y] = 0;
 }
 
+// A meeting at level y that the budget reached does not let it expand: where a larger budget
+// would, once its instances have been met kMisses times and the cache has made kStandIns
+// expansions below such levels, the budget grows to hold one of them (and a quarter more).
+void UnrollCache::Reader::missed(size_t y) {
+    Yield& yield = cache_.yield_[y];
+    if (yield.off.load(std::memory_order_relaxed) || ++misses_[y] < kUseBatch) return;
+    const uint64_t n = yield.missed.fetch_add(misses_[y], std::memory_order_relaxed) + misses_[y];
+    misses_[y] = 0;
+    if (n >= kMisses && cache_.expansions() >= kStandIns)
+        cache_.growTo(kShare * yield.want.load(std::memory_order_relaxed) * 5 / 4);
+}
+
 const UnrolledInstance* UnrollCache::Reader::built(const InstanceBoxes::Key& key, NodeId select,
                                                    uint32_t depth) {
     if (depth >= cache_.levels_ || cache_.entries() == 0) return nullptr;
     const size_t y = cache_.yieldIndex(select, depth);
-    if (cache_.yield_[y].off.load(std::memory_order_relaxed)) return nullptr;
+    if (cache_.yield_[y].skipped(cache_.budget())) return nullptr;
     Shard& s = cache_.shardOf(key);
     pinOnce();
     tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
@@ -181,8 +243,10 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
     if (const UnrolledInstance* x = built(key, select, depth)) return x;
     if (depth >= cache_.levels_) return nullptr;
     const size_t y = cache_.yieldIndex(select, depth);
-    Yield& yield = cache_.yield_[y];
-    if (yield.off.load(std::memory_order_relaxed)) return nullptr;
+    if (cache_.yield_[y].skipped(cache_.budget())) {
+        missed(y);
+        return nullptr;
+    }
     Shard& s = cache_.shardOf(key);
     pinOnce();
     Entry* e = nullptr;
@@ -200,8 +264,9 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
             used(y);
             return it->second.instance.get();
         } else if (it->second.state == Entry::State::Note) {
-            if (cache_.stopsAt(y, select, depth, it->second.evicted, uses_[y])) return nullptr;
+            if (cache_.stopsAt(y, select, depth, it->second.ghost, uses_[y])) return nullptr;
             it->second.state = Entry::State::Building;  // the second meeting: expand
+            if (it->second.ghost > 0) cache_.unghost(it->second);
             e = &it->second;
         }
     }
@@ -210,7 +275,7 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
             std::lock_guard<std::mutex> hand(cache_.queueMutex_);
             cache_.queue_.push_back(key);
         }
-        if (cache_.bytes() > cache_.maxBytes_) cache_.evict();
+        if (cache_.bytes() > cache_.budget()) cache_.evict();
         return nullptr;
     }
     return expand(s, *e, y, select, depth, frame, path);
@@ -237,6 +302,11 @@ const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e, size_t y
     {
         tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/true);
         if (b > cache_.maxInstanceBytes()) {  // (x, if any, is freed here: nobody has it)
+            // (no x: it reached the visits the budget's share allows; a larger share may hold it)
+            if (cache_.waitForRoom(cache_.yield_[y], x ? b : 2 * cache_.maxInstanceBytes())) {
+                e.state = Entry::State::Note;
+                return nullptr;
+            }
             e.state = Entry::State::TooLarge;
             cache_.refuse(y);
             return nullptr;
@@ -251,36 +321,61 @@ const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e, size_t y
     cache_.expansions_.fetch_add(1, std::memory_order_relaxed);
     cache_.count(y, select, depth, b);
     used(y);
-    if (cache_.bytes() > cache_.maxBytes_ || cache_.retiredBytes() > 0) cache_.evict();
+    if (cache_.bytes() > cache_.budget() || cache_.retiredBytes() > 0) cache_.evict();
     return result;
 }
 
 // Whether expansion stops at level y (select, depth), before the expansion of an instance
-// met a second time (`rebuild`: one that was built and evicted before): its expansions are
-// not used enough, or a third of them are rebuilds, or its instances would not fit.
-bool UnrollCache::stopsAt(size_t y, NodeId select, uint32_t depth, bool rebuild,
+// met a second time (`ghost`: the bytes of the instance built and evicted before, else 0):
+// its expansions are not used enough, or a third of them are rebuilds that the budget
+// could not grow for, or its instances would not fit the budget reached (for now).
+bool UnrollCache::stopsAt(size_t y, NodeId select, uint32_t depth, size_t ghost,
                           uint32_t pendingUses) {
     Yield& yield = yield_[y];
     const uint64_t b = yield.built.load(std::memory_order_relaxed);
     uint64_t rebuilt = yield.rebuilt.load(std::memory_order_relaxed);
-    if (rebuild) rebuilt = yield.rebuilt.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (ghost > 0 && !grow(ghost))
+        rebuilt = yield.rebuilt.fetch_add(1, std::memory_order_relaxed) + 1;
     const bool stop =
-        (b >= kTrial && (yield.used.load(std::memory_order_relaxed) + pendingUses < kUses * b ||
-                         rebuilt * kRebuilds > b)) ||
-        (b == 0 && predictedTooLarge(select, depth));
+        b >= kTrial && (yield.used.load(std::memory_order_relaxed) + pendingUses < kUses * b ||
+                        rebuilt * kRebuilds > b);
     if (stop) yield.off.store(true, std::memory_order_relaxed);
-    return stop;
+    if (b > 0 || stop) return stop;
+    const double bytes = predictedBytes(select, depth), share = maxBytes_ / kShare;
+    if (bytes <= static_cast<double>(maxInstanceBytes())) return false;
+    // Below the maximum, the level waits (for the maximum, where the estimate is above its
+    // share: the estimate is rough); at the maximum, one that waited is tried where the
+    // estimate before any expansion would have tried it (as it would have been, had the
+    // budget been the maximum from the start), and the expansion's own size decides.
+    if (budget() < maxBytes_)
+        return waitForRoom(yield, static_cast<size_t>(std::min(bytes, share)));
+    if (yield.tooLargeAt.load(std::memory_order_relaxed) > 0 &&
+        predictedBytes(select, depth, kFirstBytesPerVisit) <= share)
+        return false;
+    yield.off.store(true, std::memory_order_relaxed);
+    return true;
 }
 
-// Whether the instances at (select, depth) would take more than maxInstanceBytes(), from
-// the weight of the heaviest met there and the bytes per visit of the expansions so far.
-bool UnrollCache::predictedTooLarge(NodeId select, uint32_t depth) const {
+// An instance of `bytes` at a level (yield) does not fit the budget reached: if it would fit
+// the maximum, the level waits until the budget has grown for it (its instances' meetings
+// meanwhile are misses, missed()); else false.
+bool UnrollCache::waitForRoom(Yield& yield, size_t bytes) {
+    if (bytes > maxBytes_ / kShare) return false;
+    yield.want.store(bytes, std::memory_order_relaxed);
+    yield.tooLargeAt.store(budget(), std::memory_order_relaxed);
+    return true;
+}
+
+// The bytes of an instance at (select, depth), estimated from
+// the weight of the heaviest met there and the bytes per visit of the expansions so far
+// (at most maxPerVisit).
+double UnrollCache::predictedBytes(NodeId select, uint32_t depth, double maxPerVisit) const {
     const uint64_t w = scene_.instanceBoxes()->unrollWeight(select, depth);
     const uint64_t bytes = builtBytes_.load(std::memory_order_relaxed);
     const uint64_t visits = builtWeight_.load(std::memory_order_relaxed);
     const double perVisit =
         visits > 0 ? static_cast<double>(bytes) / static_cast<double>(visits) : kFirstBytesPerVisit;
-    return static_cast<double>(w) * perVisit > static_cast<double>(maxInstanceBytes());
+    return static_cast<double>(w) * std::min(perVisit, maxPerVisit);
 }
 
 // Counts an instance too large to keep at level y; stops expansion there when more than a

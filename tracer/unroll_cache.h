@@ -19,18 +19,30 @@
 //    (each thread adds its uses in batches); where the expansions are used less than four
 //    times each, expansion stops. None of this changes a hit: an expanded instance gives
 //    the same surfaces, bit for bit, as the graph walk.
-//  - Size: one instance may take at most an eighth of the budget. A larger one is refused
-//    (its entry stays a note that is never expanded) and so, once they are more than a
+//  - Budget: it starts small (kStartBytes, at most the maximum given) and grows toward the
+//    maximum where a larger budget would have saved expansions. Ghosts, as in ARC: an
+//    evicted instance leaves a note behind, and one met again and rebuilt while its note
+//    is there grows the budget by its bytes. Misses: a level whose instances would fit the
+//    maximum's share but not the budget reached's waits (it is not turned off); once its
+//    instances have been met kMisses times while kStandIns expansions elsewhere stood in
+//    for them, the budget grows to hold one. A tree whose every level is one instance is
+//    served by one smaller expansion (and the top level's copies of it) and stays small;
+//    one whose smaller instances are many and distinct gets the larger ones. Which budget
+//    each rule uses: eviction and an instance's share, the budget reached; the thrash
+//    rules below, the maximum (a rebuild that grew the budget is not counted as one).
+//  - Size: one instance may take at most an eighth of the budget reached. A larger one is
+//    refused (its entry stays a note that is never expanded; or, where the maximum's
+//    share holds it, its level waits, above) and so, once they are more than a
 //    few, are the others of its (module, depth), and expansion stops there: the walk
 //    goes below them and meets the smaller instances of the deeper levels, which are
 //    expanded instead. Before expanding, the bytes are estimated from the heaviest
 //    instance InstanceBoxes met at that depth and the bytes per visit of the expansions
 //    so far, so that a level far too large is not even tried.
 //  - Thrashing: an evicted instance leaves a note behind; expanding it again counts as a
-//    rebuild, and where a third of the expansions are rebuilds, expansion stops. Where
-//    instances larger than 1/64 of the budget have been built for more bytes, in all,
-//    than half the budget (a terrain's patches, each used by the rays of a few tiles, or
-//    a level the budget cannot hold twice over), it stops
+//    rebuild (when the budget is at its maximum), and where a third of the expansions are
+//    rebuilds, expansion stops. Where instances larger than 1/64 of the maximum have been
+//    built for more bytes, in all, than half the maximum (a terrain's patches, each used by
+//    the rays of a few tiles, or a level the budget cannot hold twice over), it stops
 //    too: large instances pay only where they are few and used again and again (a
 //    deterministic tree or fractal, whose every level is one instance).
 #pragma once
@@ -50,7 +62,8 @@ namespace pcsg::tracer {
 
 class UnrollCache {
   public:
-    UnrollCache(const TraceScene& scene, size_t maxBytes);
+    // A budget of at most maxBytes, starting at startBytes (or maxBytes if less).
+    UnrollCache(const TraceScene& scene, size_t maxBytes, size_t startBytes = kStartBytes);
     ~UnrollCache();  // (after its readers)
     UnrollCache(const UnrollCache&) = delete;
     UnrollCache& operator=(const UnrollCache&) = delete;
@@ -65,8 +78,12 @@ class UnrollCache {
     size_t entries() const { return entries_.load(std::memory_order_relaxed); }
     size_t retiredBytes() const { return retired_.pendingBytes(); }
     size_t maxBytes() const { return maxBytes_; }
-    // The largest instance kept (an eighth of the budget).
+    // The budget reached (the start, grown by the ghosts' hits and the misses, see above).
+    size_t budget() const { return budget_.load(std::memory_order_relaxed); }
+    // The largest instance kept (an eighth of the budget reached).
     size_t maxInstanceBytes() const;
+    // Where the budget starts (unless told).
+    static constexpr size_t kStartBytes = size_t{2} << 20;
 
     // What happened at one (module, depth) so far.
     struct Level {
@@ -91,13 +108,18 @@ class UnrollCache {
     Shard& shardOf(const InstanceBoxes::Key& k) const;
     size_t yieldIndex(NodeId select, uint32_t depth) const;
     void evict();
-    bool predictedTooLarge(NodeId select, uint32_t depth) const;
-    bool stopsAt(size_t y, NodeId select, uint32_t depth, bool rebuild, uint32_t pendingUses);
+    double predictedBytes(NodeId select, uint32_t depth, double maxPerVisit = 1e300) const;
+    bool waitForRoom(Yield& yield, size_t bytes);
+    void growTo(size_t bytes);
+    void unghost(Entry& e);
+    bool stopsAt(size_t y, NodeId select, uint32_t depth, size_t ghost, uint32_t pendingUses);
     void count(size_t y, NodeId select, uint32_t depth, size_t bytes);
     void refuse(size_t y);
+    bool grow(size_t bytes);
 
     const TraceScene& scene_;
     const size_t maxBytes_;
+    std::atomic<size_t> budget_;
     const uint32_t levels_;
     std::unique_ptr<Shard[]> shards_;
     std::unique_ptr<Yield[]> yield_;
@@ -108,6 +130,7 @@ class UnrollCache {
     std::atomic<uint64_t> builtBytes_{0}, builtWeight_{0};
     std::mutex queueMutex_;
     std::deque<InstanceBoxes::Key> queue_;  // every entry, in the order of insertion
+    std::atomic<size_t> ghostBytes_{0};     // of the evicted instances whose ghosts stay
     DeferredFree retired_;
 };
 
@@ -144,12 +167,14 @@ class UnrollCache::Reader {
     const UnrolledInstance* expand(Shard& s, Entry& e, size_t y, NodeId select, uint32_t depth,
                                    const double* frame, uint64_t path);
     void used(size_t y);
+    void missed(size_t y);
 
     UnrollCache& cache_;
     DeferredFree::Slot* slot_;
     uint32_t scopes_ = 0;  // nested Pin scopes
     bool pinned_ = false;
-    std::vector<uint32_t> uses_;  // per (module, depth): not yet added to the cache's
+    std::vector<uint32_t> uses_;    // per (module, depth): not yet added to the cache's
+    std::vector<uint32_t> misses_;  // (the same, of meetings a larger budget would expand)
     uint64_t expansions_ = 0;
     UnrolledInstance::Scratch scratch_;
 };

@@ -4,7 +4,8 @@
 // reader unpins; tracers on several threads find the same hits as the graph walk; an
 // instance larger than its share of the budget is refused and the level below it is
 // expanded instead; levels of large instances that do not stay, and levels whose
-// instances are rebuilt after eviction, stop expanding.
+// instances are rebuilt after eviction, stop expanding; the budget starts small and grows
+// only where a larger one would have saved expansions.
 #include "unroll_cache.h"
 
 #include <gtest/gtest.h>
@@ -279,6 +280,107 @@ TEST(UnrollCache, ALevelWhoseInstancesAreRebuiltAfterEvictionStopsExpanding) {
     EXPECT_GE(pass, 2) << level.built << " " << level.rebuilt;  // (the first pass builds each once)
     EXPECT_GT(level.rebuilt * 3, level.built - level.rebuilt);
     EXPECT_EQ(level.refused, 0u);
+}
+
+// 150 small flowers in a cache whose budget starts with room for 40 of them and may grow
+// to 1,000.
+struct SmallFlowers {
+    SmallFlowers()
+        : c(compile(kFlower)),
+          scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion()),
+          f(*c->graph),
+          each(flowerBytes(scene, f, 1.5) + 256),
+          cache(scene, 1000 * each, 40 * each),
+          reader(cache) {}
+    // Meets each flower `uses` times in a row; false if the cache went over its budget.
+    bool pass(int uses) {
+        bool within = true;
+        for (int i = 1; i <= 150; ++i)
+            for (int use = 0; use < uses; ++use) {
+                const UnrollCache::Pin pin(&reader);
+                f.get(reader, 1 + i / 1000.0);
+                within = within && cache.bytes() <= cache.budget();
+            }
+        return within;
+    }
+    std::unique_ptr<testing::Compiled> c;
+    TraceScene scene;
+    Flower f;
+    size_t each;
+    UnrollCache cache;
+    UnrollCache::Reader reader;
+};
+
+TEST(UnrollCache, TheBudgetGrowsForEvictedInstancesMetAgainUpToWhatTheyNeed) {
+    SmallFlowers s;  // (met again and again)
+    ASSERT_EQ(s.cache.budget(), 40 * s.each);
+    uint64_t lastPass = 0;
+    for (int pass = 0; pass < 5; ++pass) {
+        const uint64_t before = s.cache.expansions();
+        EXPECT_TRUE(s.pass(8)) << "pass " << pass;
+        lastPass = s.cache.expansions() - before;
+    }
+    const UnrollCache::Level level = s.cache.level(s.f.select, 1);
+    EXPECT_FALSE(level.off);       // (with a fixed budget of 40 it thrashes and stops)
+    EXPECT_EQ(level.rebuilt, 0u);  // every rebuild grew the budget
+    EXPECT_GT(s.cache.budget(), 150 * (s.each - 256));  // it holds them all now ...
+    EXPECT_LT(s.cache.budget(), 300 * s.each);          // ... and not much more
+    EXPECT_EQ(lastPass, 0u);
+}
+
+TEST(UnrollCache, InstancesNotMetAgainLeaveTheBudgetWhereItStarts) {
+    SmallFlowers s;
+    EXPECT_TRUE(s.pass(8));  // (each used eight times and then never again)
+    EXPECT_EQ(s.cache.expansions(), 150u);
+    EXPECT_EQ(s.cache.budget(), 40 * s.each);
+    EXPECT_LE(s.cache.bytes(), 40 * s.each);  // (the maximum would have kept all 150)
+}
+
+// Flowers of 21 petals (too large for the start's share, not for the maximum's), met
+// `meetings` times each, after `standIns` small flowers were expanded at depth 3.
+struct WaitingLevel {
+    WaitingLevel(int standIns, int meetings)
+        : c(compile(kFlower)),
+          scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion()),
+          f(*c->graph),
+          large(flowerBytes(scene, f, 20.5) + 256),
+          cache(scene, 64 * large, 4 * large) {
+        UnrollCache::Reader reader(cache);
+        for (int i = 1; i <= standIns; ++i)
+            for (int use = 0; use < 8; ++use) {
+                const UnrollCache::Pin pin(&reader);
+                f.get(reader, 1 + i / 1000.0, 3);
+            }
+        for (int m = 0; m < meetings; ++m) {
+            const UnrollCache::Pin pin(&reader);
+            if (f.get(reader, 20 + (m % 4) / 1000.0)) ++got;
+        }
+    }
+    std::unique_ptr<testing::Compiled> c;
+    TraceScene scene;
+    Flower f;
+    size_t large;
+    UnrollCache cache;
+    int got = 0;
+};
+
+TEST(UnrollCache, ALevelTooLargeForTheStartGetsTheBudgetOnceOtherExpansionsStandInForIt) {
+    WaitingLevel w(8, 2000);
+    EXPECT_GE(w.cache.budget(), 8 * w.large);
+    EXPECT_LE(w.cache.budget(), 64 * w.large);
+    const UnrollCache::Level level = w.cache.level(w.f.select, 1);
+    EXPECT_FALSE(level.off);
+    EXPECT_GE(level.built, 1u);
+    EXPECT_GT(w.got, 0);
+}
+
+TEST(UnrollCache, ALevelTooLargeForTheStartWithNoStandInsLeavesTheBudgetSmall) {
+    WaitingLevel w(1, 2000);  // (a tree whose levels are one instance each)
+    EXPECT_EQ(w.cache.budget(), 4 * w.large);
+    const UnrollCache::Level level = w.cache.level(w.f.select, 1);
+    EXPECT_EQ(level.built, 0u);
+    EXPECT_FALSE(level.off);  // (it still waits)
+    EXPECT_EQ(w.got, 0);
 }
 
 }  // namespace

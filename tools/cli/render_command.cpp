@@ -365,6 +365,7 @@ void printJson(const RenderCommandOptions& o, const RenderReport& report) {
                            {"computed", result.instanceBoxes.computed},
                            {"full", result.instanceBoxes.full}};
     j["expanded_instances"] = result.expansions;
+    j["expansion_budget_bytes"] = result.expansionBudget;  // reached (at most the maximum)
     j["aa"] = o.aa;
     j["adaptive"] = o.adaptive;
     j["graph_nodes"] = report.graphNodes;
@@ -532,6 +533,8 @@ nlohmann::json frameJson(const FrameFigures& f) {
                         // unrolled in this frame (not found in the table, nor in the
                         // sequence's, which keeps the boxes that do not change with the time)
                         {"instance_boxes_computed", f.result.instanceBoxes.computed},
+                        {"expanded_instances", f.result.expansions},
+                        {"expansion_budget_bytes", f.result.expansionBudget},
                         {"image_write_seconds", f.imageWriteSeconds}};
     if (f.primitives) j["primitive_equivalence"] = *f.primitives;
     return j;
@@ -926,7 +929,8 @@ void addRenderCommand(CLI::App& app, int& status) {
     cmd->add_option("--expansion-cache-mb", o->expansionCacheMb,
                     "Memory limit in MB of the cache of expanded sub-graph instances, shared "
                     "by all threads (small instances unrolled once and traced as flat arrays; "
-                    "0: none; the image is the same)")
+                    "its budget starts at 2 MB and grows toward this limit where a larger "
+                    "one saves expansions; 0: none; the image is the same)")
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     cmd->add_option("--count-visits", o->countVisits,
