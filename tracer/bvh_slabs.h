@@ -172,15 +172,6 @@ inline int enterChildrenFloat(const UnrolledInstance::BvhNode& b, const FloatRay
     return _mm_movemask_ps(_mm_cmple_ps(lo, hi)) & used;
 }
 
-// The same with the entries in doubles (the floats' values).
-inline int enterChildrenFloat(const UnrolledInstance::BvhNode& b, const FloatRay& f, double tmax,
-                              double t0[4]) {
-    float t[4];
-    const int mask = enterChildrenFloat(b, f, tmax, t);
-    for (int c = 0; c < 4; ++c) t0[c] = t[c];
-    return mask;
-}
-
 #endif
 
 }  // namespace pcsg::tracer

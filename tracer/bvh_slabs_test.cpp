@@ -21,7 +21,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Compares the two tests on node b for ray r; returns the children the doubles meet.
 int expectFloatHoldsDouble(const UnrolledInstance::BvhNode& b, const LocalRay& r, double tmin,
                            double tmax) {
-    double td[4] = {}, tf[4] = {};
+    double td[4] = {};
+    float tf[4] = {};
     const int exact = enterChildren(b, r, tmin, tmax, td);
     const FloatRay f = floatRay(r, tmin);
     EXPECT_TRUE(f.ok);

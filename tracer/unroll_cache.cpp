@@ -89,8 +89,6 @@ size_t UnrollCache::maxInstanceBytes() const {
     return budget() / kShare;
 }
 
-// Grows the budget by `bytes` (an evicted instance met again), up to the maximum; false
-// when it is at the maximum already.
 // An evicted instance's ghost is being expanded again (under its shard's write lock).
 void UnrollCache::unghost(Entry& e) {
     ghostBytes_.fetch_sub(e.ghost, std::memory_order_relaxed);
@@ -105,6 +103,8 @@ void UnrollCache::growTo(size_t bytes) {
     }
 }
 
+// Grows the budget by `bytes` (an evicted instance met again), up to the maximum; false
+// when it is at the maximum already.
 bool UnrollCache::grow(size_t bytes) {
     size_t b = budget();
     while (b < maxBytes_ && !budget_.compare_exchange_weak(b, std::min(maxBytes_, b + bytes),
