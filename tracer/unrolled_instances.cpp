@@ -13,6 +13,7 @@
 #include "eval.h"
 #include "eval_core.h"
 #include "flat_index.h"
+#include "map_ray.h"
 #include "outward_float.h"
 #include "traversal.h"
 
@@ -585,12 +586,8 @@ size_t UnrolledInstance::looseOperands() const {
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
-    LocalRay rr = r;
-    for (uint32_t k = 0; k < node.matrices; ++k) {
-        const Affine& m = matrices_[matrixRefs_[node.firstMatrix + k]];
-        rr = LocalRay{m.point(rr.o), m.vector(rr.d)};
-    }
-    return rr;
+    if (node.matrices == 0) return r;  // (with its reciprocals, if computed)
+    return mapRay(matrices_.data(), matrixRefs_.data() + node.firstMatrix, node.matrices, r);
 }
 
 Vec3 UnrolledInstance::leave(const Node& node, Vec3 normal) const {
@@ -608,8 +605,7 @@ const LocalRay& UnrolledInstance::linkedRay(uint32_t l, const LocalRay& r, uint6
     if (e.stamp == stamp) return e.ray;
     const Link& link = links_[l];
     const LocalRay& from = link.parent == kNone ? r : linkedRay(link.parent, r, stamp, s);
-    const Affine& m = matrices_[link.matrix];
-    e.ray = LocalRay{m.point(from.o), m.vector(from.d)};
+    e.ray = mapRay(matrices_[link.matrix], from);
     e.stamp = stamp;
     return e.ray;
 }
