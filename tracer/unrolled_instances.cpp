@@ -151,6 +151,13 @@ class Unroller {
     void finish(uint32_t root) {
         out_.root_ = root;
         if (out_.root_ != kNone) hierarchy(out_.root_);
+        out_.rootBvh_ = kNone;
+        if (root != kNone) {
+            const Node& r = out_.nodes_[root];
+            if (isUnion(r) && r.matrices == 0 && !r.looseInBvh &&
+                r.material == UnrolledInstance::kInherit)
+                out_.rootBvh_ = r.bvh;
+        }
         out_.linkSlots_ = static_cast<uint32_t>(out_.links_.size());
         for (const UnrolledInstance::Reference& x : out_.instances_)
             out_.linkSlots_ = std::max(out_.linkSlots_, x.instance->linkSlots_);
@@ -682,15 +689,10 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             }
             break;
         }
-        case Kind::Instance: {
-            // first() without its clip to the instance's box: this node's box, which holds
-            // it, has been met (boxes only cull), and first() on the top level has sized
-            // s.linked for the instances too.
-            const UnrolledInstance& x = *instances_[node.first].instance;
-            const Use inside{instances_[node.first].path, material, paint};
-            found = x.root_ != kNone && x.firstAt(x.root_, rr, tmin, tmax, hit, inside, anyHit, s);
+        case Kind::Instance:
+            found = firstInInstance(instances_[node.first], rr, tmin, tmax, hit,
+                                    Use{instances_[node.first].path, material, paint}, anyHit, s);
             break;
-        }
         case Kind::Operator:
             if (node.op != CsgOp::Union) {
                 std::vector<Span>& buffer = s.spans;
@@ -712,6 +714,23 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
     }
     if (found) hit.normal = leave(node, hit.normal);
     return found;
+}
+
+// An Instance node's instance, the ray in its S-node's frame: first() without its clip to
+// the instance's box (this node's box, which holds it, has been met, and boxes only cull;
+// first() on the top level has sized s.linked for the instances too), and straight into
+// the root's hierarchy where firstAt(root_) would only walk it. (Out of line: firstAt, the
+// primitives' walk too, stays as small as it was.)
+[[gnu::noinline]] bool UnrolledInstance::firstInInstance(const Reference& ref, const LocalRay& r,
+                                                         double tmin, double& tmax, Hit& hit,
+                                                         const Use& inside, bool anyHit,
+                                                         Scratch& s) const {
+    const UnrolledInstance& x = *ref.instance;
+    if (x.rootBvh_ != kNone) {
+        ++s.visits;  // (as firstAt(root_) counts it)
+        return x.firstBvh(x.rootBvh_, r, tmin, tmax, hit, inside, anyHit, s);
+    }
+    return x.root_ != kNone && x.firstAt(x.root_, r, tmin, tmax, hit, inside, anyHit, s);
 }
 
 // The first hit among the nodes list[0..count), all entered from the same frame, as the
