@@ -38,6 +38,21 @@ T if(n > 0, 2, 1)
 2: T -> {n = n-1} (move(1,0,0) uscale(0.5) T ∪ move(-1,0,0) uscale(0.5) T)
 )";
 
+// Instances whose root union has a matrix and a paint of its own above it (each level
+// turned and painted green below the copies' blue and red): an Instance node must enter
+// them through firstAt, which applies both, not straight into the union's hierarchy.
+const char* kTurnedRoots = R"(
+material red { color <1,0,0> }
+material blue { color <0,0,1> }
+material green { color <0,1,0> }
+{n = 4} (paint(blue) T ∪ move(0.3,0,0) paint(red) T ∪ move(0,0,-2) plane)
+T if(n > 0, 2, 1)
+1: T -> sphere
+2: T -> {n = n-1} paint(green) rotz(25) (move(1,0,0) uscale(0.5) T ∪ move(-1,0,0) uscale(0.5) T ∪
+                                            move(0,1,0) uscale(0.4) T ∪ move(0,0,1) uscale(0.3) T ∪
+                                            move(0,-1,0.5) uscale(0.3) T)
+)";
+
 // A difference above the recursion: no top level, the walk as before.
 const std::string kCsgAbove = std::string(testing::kSierpinski)
                                   .replace(std::string(testing::kSierpinski).find("{c = 4} S"), 9,
@@ -138,6 +153,13 @@ TEST(TopLevel, FlowersInheritTheirCopiesMaterialsAndHitTheWalksSurfaces) {
 TEST(TopLevel, TiesBetweenCopiesGoByTheInstancePathAsInTheWalk) {
     const Result r = compareWithGraphWalk(kTwins, 1500, 1.5);
     ASSERT_TRUE(r.built);
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, InstancesWithTheirOwnMatricesAndPaintAtTheRootHitTheWalksSurfaces) {
+    const Result r = compareWithGraphWalk(kTurnedRoots, 1500, 1.5);
+    ASSERT_TRUE(r.built);
+    EXPECT_GE(r.copies, 2u);
     EXPECT_GT(r.hits, 300u);
 }
 

@@ -13,6 +13,7 @@
 #include "eval.h"
 #include "eval_core.h"
 #include "flat_index.h"
+#include "map_ray.h"
 #include "outward_float.h"
 #include "traversal.h"
 
@@ -150,6 +151,13 @@ class Unroller {
     void finish(uint32_t root) {
         out_.root_ = root;
         if (out_.root_ != kNone) hierarchy(out_.root_);
+        out_.rootBvh_ = kNone;
+        if (root != kNone) {
+            const Node& r = out_.nodes_[root];
+            if (isUnion(r) && r.matrices == 0 && !r.looseInBvh &&
+                r.material == UnrolledInstance::kInherit)
+                out_.rootBvh_ = r.bvh;
+        }
         out_.linkSlots_ = static_cast<uint32_t>(out_.links_.size());
         for (const UnrolledInstance::Reference& x : out_.instances_)
             out_.linkSlots_ = std::max(out_.linkSlots_, x.instance->linkSlots_);
@@ -585,12 +593,8 @@ size_t UnrolledInstance::looseOperands() const {
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {
-    LocalRay rr = r;
-    for (uint32_t k = 0; k < node.matrices; ++k) {
-        const Affine& m = matrices_[matrixRefs_[node.firstMatrix + k]];
-        rr = LocalRay{m.point(rr.o), m.vector(rr.d)};
-    }
-    return rr;
+    if (node.matrices == 0) return r;  // (with its reciprocals, if computed)
+    return mapRay(matrices_.data(), matrixRefs_.data() + node.firstMatrix, node.matrices, r);
 }
 
 Vec3 UnrolledInstance::leave(const Node& node, Vec3 normal) const {
@@ -608,8 +612,7 @@ const LocalRay& UnrolledInstance::linkedRay(uint32_t l, const LocalRay& r, uint6
     if (e.stamp == stamp) return e.ray;
     const Link& link = links_[l];
     const LocalRay& from = link.parent == kNone ? r : linkedRay(link.parent, r, stamp, s);
-    const Affine& m = matrices_[link.matrix];
-    e.ray = LocalRay{m.point(from.o), m.vector(from.d)};
+    e.ray = mapRay(matrices_[link.matrix], from);
     e.stamp = stamp;
     return e.ray;
 }
@@ -686,15 +689,10 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             }
             break;
         }
-        case Kind::Instance: {
-            // first() without its clip to the instance's box: this node's box, which holds
-            // it, has been met (boxes only cull), and first() on the top level has sized
-            // s.linked for the instances too.
-            const UnrolledInstance& x = *instances_[node.first].instance;
-            const Use inside{instances_[node.first].path, material, paint};
-            found = x.root_ != kNone && x.firstAt(x.root_, rr, tmin, tmax, hit, inside, anyHit, s);
+        case Kind::Instance:
+            found = firstInInstance(instances_[node.first], rr, tmin, tmax, hit,
+                                    Use{instances_[node.first].path, material, paint}, anyHit, s);
             break;
-        }
         case Kind::Operator:
             if (node.op != CsgOp::Union) {
                 std::vector<Span>& buffer = s.spans;
@@ -716,6 +714,23 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
     }
     if (found) hit.normal = leave(node, hit.normal);
     return found;
+}
+
+// An Instance node's instance, the ray in its S-node's frame: first() without its clip to
+// the instance's box (this node's box, which holds it, has been met, and boxes only cull;
+// first() on the top level has sized s.linked for the instances too), and straight into
+// the root's hierarchy where firstAt(root_) would only walk it. (Out of line: firstAt, the
+// primitives' walk too, stays as small as it was.)
+[[gnu::noinline]] bool UnrolledInstance::firstInInstance(const Reference& ref, const LocalRay& r,
+                                                         double tmin, double& tmax, Hit& hit,
+                                                         const Use& inside, bool anyHit,
+                                                         Scratch& s) const {
+    const UnrolledInstance& x = *ref.instance;
+    if (x.rootBvh_ != kNone) {
+        ++s.visits;  // (as firstAt(root_) counts it)
+        return x.firstBvh(x.rootBvh_, r, tmin, tmax, hit, inside, anyHit, s);
+    }
+    return x.root_ != kNone && x.firstAt(x.root_, r, tmin, tmax, hit, inside, anyHit, s);
 }
 
 // The first hit among the nodes list[0..count), all entered from the same frame, as the

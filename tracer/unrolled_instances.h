@@ -174,6 +174,9 @@ class UnrolledInstance {
 
     bool firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
                  bool anyHit, Scratch& s) const;
+    struct Reference;
+    bool firstInInstance(const Reference& ref, const LocalRay& r, double tmin, double& tmax,
+                         Hit& hit, const Use& inside, bool anyHit, Scratch& s) const;
     size_t spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
                    std::vector<Span>& spans, const Use& use, Scratch& s) const;
     bool firstOfNodes(const uint32_t* list, uint32_t count, const LocalRay& r, double tmin,
@@ -201,6 +204,11 @@ class UnrolledInstance {
     std::vector<Reference> instances_;
     uint32_t linkSlots_ = 0;  // Scratch::linked entries needed, instances referred to included
     uint32_t root_ = kNone;
+    // The root's first-hit hierarchy when firstAt(root_) would do nothing but walk it (a
+    // union with one, without matrices, own box test or material): an Instance node
+    // referring to this instance walks it directly, one call and one copy of the ray less
+    // for each copy entered. Else kNone.
+    uint32_t rootBvh_ = kNone;
     uint32_t levels_ = 0;
     uint32_t bvhLeaves_ = 0;
 };
