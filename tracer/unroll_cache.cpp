@@ -35,6 +35,10 @@ constexpr uint64_t kRebuilds = 3;
 // smaller instances are many and distinct (a tree whose branches sway each in its own way)
 // gains from the larger ones.
 constexpr uint64_t kMisses = 256, kStandIns = 4;
+// An evicted instance met again grows the budget only while such meetings are at least
+// 1/kGhostRate of the instances evicted so far: where they are fewer (a terrain's patches,
+// met again mostly far apart), the growth would buy few expansions for its bytes.
+constexpr uint64_t kGhostRate = 8;
 // The bytes per node visit of an expansion: the estimate before the first one, and the
 // fewest, which bounds the visits of one (an expansion that reaches the limit is refused).
 constexpr double kFirstBytesPerVisit = 64;
@@ -65,6 +69,7 @@ struct UnrollCache::Yield {
     std::atomic<size_t> tooLargeAt{0};
     std::atomic<size_t> want{0};      // the bytes of such an instance (predicted or built)
     std::atomic<uint64_t> missed{0};  // meetings of its instances since
+    std::atomic<size_t> grew{0};      // what the budget grew by for it (misses)
     bool skipped(size_t budget) const {
         return off.load(std::memory_order_relaxed) ||
                tooLargeAt.load(std::memory_order_relaxed) >= budget;
@@ -74,7 +79,8 @@ struct UnrollCache::Yield {
 UnrollCache::UnrollCache(const TraceScene& scene, size_t maxBytes, size_t startBytes)
     : scene_(scene),
       maxBytes_(maxBytes),
-      budget_(std::min(maxBytes, startBytes)),
+      startBytes_(std::min(maxBytes, startBytes)),
+      budget_(startBytes_),
       levels_(scene.graph().scene.settings.maxDepth + 2),
       shards_(std::make_unique<Shard[]>(kShards)),
       yield_(std::make_unique<Yield[]>(scene.graph().modules.size() * levels_)) {}
@@ -95,12 +101,32 @@ void UnrollCache::unghost(Entry& e) {
     e.ghost = 0;
 }
 
-// Grows the budget to `bytes` (at most the maximum), if it is less.
-void UnrollCache::growTo(size_t bytes) {
+// Grows the budget to `bytes` (at most the maximum), if it is less; returns the growth.
+size_t UnrollCache::growTo(size_t bytes) {
     size_t b = budget();
     const size_t want = std::min(maxBytes_, bytes);
     while (b < want && !budget_.compare_exchange_weak(b, want, std::memory_order_relaxed)) {
     }
+    return b < want ? want - b : 0;
+}
+
+// Expansion stops at a level; the budget grown for its misses goes back (to the start at
+// least): the larger instances it waited for did not pay.
+void UnrollCache::turnOff(Yield& yield) {
+    if (yield.off.exchange(true, std::memory_order_relaxed)) return;
+    const size_t grew = yield.grew.exchange(0, std::memory_order_relaxed);
+    size_t b = budget();
+    while (grew > 0 && b > startBytes_ &&
+           !budget_.compare_exchange_weak(b, std::max(startBytes_, b - std::min(b, grew)),
+                                          std::memory_order_relaxed)) {
+    }
+}
+
+// An evicted instance is met again while its ghost is there: whether such meetings are
+// frequent enough, of all the evictions so far, for a larger budget to pay.
+bool UnrollCache::ghostsPay() {
+    const uint64_t hits = ghostHits_.fetch_add(1, std::memory_order_relaxed) + 1;
+    return hits * kGhostRate >= evicted_.load(std::memory_order_relaxed);
 }
 
 // Grows the budget by `bytes` (an evicted instance met again), up to the maximum; false
@@ -151,6 +177,7 @@ void UnrollCache::evict() {
                 out.push_back(std::move(e.instance));
                 bytes_.fetch_sub(e.bytes, std::memory_order_relaxed);
                 ghostBytes_.fetch_add(e.ghost = e.bytes, std::memory_order_relaxed);
+                evicted_.fetch_add(1, std::memory_order_relaxed);
                 e.bytes = 0;  // (a ghost's few bytes are not counted)
                 e.state = Entry::State::Note;
                 e.referenced.store(true, std::memory_order_relaxed);  // (a second round)
@@ -203,7 +230,9 @@ void UnrollCache::Reader::missed(size_t y) {
     const uint64_t n = yield.missed.fetch_add(misses_[y], std::memory_order_relaxed) + misses_[y];
     misses_[y] = 0;
     if (n >= kMisses && cache_.expansions() >= kStandIns)
-        cache_.growTo(kShare * yield.want.load(std::memory_order_relaxed) * 5 / 4);
+        yield.grew.fetch_add(
+            cache_.growTo(kShare * yield.want.load(std::memory_order_relaxed) * 5 / 4),
+            std::memory_order_relaxed);
 }
 
 const UnrolledInstance* UnrollCache::Reader::built(const InstanceBoxes::Key& key, NodeId select,
@@ -334,12 +363,12 @@ bool UnrollCache::stopsAt(size_t y, NodeId select, uint32_t depth, size_t ghost,
     Yield& yield = yield_[y];
     const uint64_t b = yield.built.load(std::memory_order_relaxed);
     uint64_t rebuilt = yield.rebuilt.load(std::memory_order_relaxed);
-    if (ghost > 0 && !grow(ghost))
+    if (ghost > 0 && !(ghostsPay() && grow(ghost)))
         rebuilt = yield.rebuilt.fetch_add(1, std::memory_order_relaxed) + 1;
     const bool stop =
         b >= kTrial && (yield.used.load(std::memory_order_relaxed) + pendingUses < kUses * b ||
                         rebuilt * kRebuilds > b);
-    if (stop) yield.off.store(true, std::memory_order_relaxed);
+    if (stop) turnOff(yield);
     if (b > 0 || stop) return stop;
     const double bytes = predictedBytes(select, depth), share = maxBytes_ / kShare;
     if (bytes <= static_cast<double>(maxInstanceBytes())) return false;
@@ -352,7 +381,7 @@ bool UnrollCache::stopsAt(size_t y, NodeId select, uint32_t depth, size_t ghost,
     if (yield.tooLargeAt.load(std::memory_order_relaxed) > 0 &&
         predictedBytes(select, depth, kFirstBytesPerVisit) <= share)
         return false;
-    yield.off.store(true, std::memory_order_relaxed);
+    turnOff(yield);
     return true;
 }
 
@@ -383,8 +412,7 @@ double UnrollCache::predictedBytes(NodeId select, uint32_t depth, double maxPerV
 void UnrollCache::refuse(size_t y) {
     Yield& yield = yield_[y];
     const uint64_t refused = yield.refused.fetch_add(1, std::memory_order_relaxed) + 1;
-    if (refused * 4 > yield.built.load(std::memory_order_relaxed))
-        yield.off.store(true, std::memory_order_relaxed);
+    if (refused * 4 > yield.built.load(std::memory_order_relaxed)) turnOff(yield);
 }
 
 // Counts an expansion of `bytes` at level y; stops expansion there when its large
@@ -399,7 +427,7 @@ void UnrollCache::count(size_t y, NodeId select, uint32_t depth, size_t bytes) {
     }
     if (bytes <= maxBytes_ / kLarge) return;
     if (yield.largeBytes.fetch_add(bytes, std::memory_order_relaxed) + bytes > maxBytes_ / 2)
-        yield.off.store(true, std::memory_order_relaxed);
+        turnOff(yield);
 }
 
 }  // namespace pcsg::tracer

@@ -27,7 +27,11 @@
 //    instances have been met kMisses times while kStandIns expansions elsewhere stood in
 //    for them, the budget grows to hold one. A tree whose every level is one instance is
 //    served by one smaller expansion (and the top level's copies of it) and stays small;
-//    one whose smaller instances are many and distinct gets the larger ones. Which budget
+//    one whose smaller instances are many and distinct gets the larger ones. What a level's
+//    misses grew the budget by goes back when expansion stops there (its larger instances
+//    did not pay: a terrain's patches of depth 6 and 7). Ghosts grow the budget only while
+//    their meetings are at least an eighth of the evictions so far (kGhostRate): a
+//    terrain's patches, met again mostly far apart, leave it below the maximum. Which budget
 //    each rule uses: eviction and an instance's share, the budget reached; the thrash
 //    rules below, the maximum (a rebuild that grew the budget is not counted as one).
 //  - Size: one instance may take at most an eighth of the budget reached. A larger one is
@@ -110,15 +114,17 @@ class UnrollCache {
     void evict();
     double predictedBytes(NodeId select, uint32_t depth, double maxPerVisit = 1e300) const;
     bool waitForRoom(Yield& yield, size_t bytes);
-    void growTo(size_t bytes);
+    size_t growTo(size_t bytes);
+    void turnOff(Yield& yield);
     void unghost(Entry& e);
     bool stopsAt(size_t y, NodeId select, uint32_t depth, size_t ghost, uint32_t pendingUses);
     void count(size_t y, NodeId select, uint32_t depth, size_t bytes);
     void refuse(size_t y);
     bool grow(size_t bytes);
+    bool ghostsPay();
 
     const TraceScene& scene_;
-    const size_t maxBytes_;
+    const size_t maxBytes_, startBytes_;
     std::atomic<size_t> budget_;
     const uint32_t levels_;
     std::unique_ptr<Shard[]> shards_;
@@ -131,6 +137,7 @@ class UnrollCache {
     std::mutex queueMutex_;
     std::deque<InstanceBoxes::Key> queue_;  // every entry, in the order of insertion
     std::atomic<size_t> ghostBytes_{0};     // of the evicted instances whose ghosts stay
+    std::atomic<uint64_t> evicted_{0}, ghostHits_{0};
     DeferredFree retired_;
 };
 

@@ -53,6 +53,30 @@ struct BuildArrays {
     bool lent = false;
 };
 
+namespace {
+
+// The thread's array b after an expansion that used `used` of it: kept for the next one,
+// unless it is far larger than that (a one-off: a larger level tried, a build refused at
+// its visit limit), which would otherwise stay with the thread for the rest of the run.
+constexpr size_t kKeptSlack = 4, kKeptFreely = 64 * 1024;
+
+BuildArrays& threadArrays() {
+    thread_local BuildArrays a;
+    return a;
+}
+
+template <class V>
+void giveBack(V& b, size_t used, bool keep) {
+    const size_t bytes = b.capacity() * sizeof(typename V::value_type);
+    if (keep && (bytes <= kKeptFreely || b.capacity() <= kKeptSlack * used)) {
+        b.clear();
+        return;
+    }
+    V().swap(b);
+}
+
+}  // namespace
+
 class Unroller {
   public:
     Unroller(const TraceScene& scene, UnrolledInstance& out, uint64_t maxVisits,
@@ -107,7 +131,7 @@ class Unroller {
     class Lent {
       public:
         explicit Lent(UnrolledInstance& x, bool keep = true)
-            : x_(x), b_(arrays()), mine_(!b_.lent), keep_(keep) {
+            : x_(x), b_(threadArrays()), mine_(!b_.lent), keep_(keep) {
             if (!mine_) return;
             b_.lent = true;
             eachArray(b_, x_, [](auto& b, auto& x) {
@@ -124,8 +148,7 @@ class Unroller {
             eachArray(b_, x_, [done, keep = keep_](auto& b, auto& x) {
                 b.swap(x);
                 if (done) x.assign(b.begin(), b.end());
-                b.clear();
-                if (!keep) b.shrink_to_fit();
+                giveBack(b, b.size(), keep);
             });
             b_.lent = false;
         }
@@ -133,10 +156,6 @@ class Unroller {
         Lent& operator=(const Lent&) = delete;
 
       private:
-        static BuildArrays& arrays() {
-            thread_local BuildArrays a;
-            return a;
-        }
         UnrolledInstance& x_;
         BuildArrays& b_;
         const bool mine_, keep_;
@@ -871,6 +890,17 @@ std::unique_ptr<UnrolledInstance> UnrolledInstance::expand(const TraceScene& sce
         return nullptr;
     }
     return x;
+}
+
+size_t UnrolledInstance::keptBuildBytes() {
+    BuildArrays& b = threadArrays();
+    size_t bytes = 0;
+    const auto add = [&bytes](const auto& v) {
+        bytes += v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type);
+    };
+    add(b.nodes), add(b.children), add(b.matrixRefs), add(b.choices);
+    add(b.matrices), add(b.args), add(b.bvh), add(b.links);
+    return bytes;
 }
 
 std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts) {

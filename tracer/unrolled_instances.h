@@ -153,6 +153,9 @@ class UnrolledInstance {
     // node whose pattern needs the node's frame, or is refused. Throws RuntimeError when
     // unrolling meets a run-time error. Traced with first() and Use{kRootPath, 0, 0}.
     static std::unique_ptr<UnrolledInstance> expandTop(const TraceScene& scene, Cuts& cuts);
+    // The bytes of the build arrays the calling thread keeps between its expansions (they
+    // keep their capacity, unless far larger than the last expansion needed).
+    static size_t keptBuildBytes();
 
     const Box& box() const { return nodes_[root_].box; }
     bool empty() const { return root_ == kNone; }

@@ -300,6 +300,44 @@ TEST(ExpandedInstances, AnExpansionsArraysAreItsOwnWhateverTheThreadBuiltBefore)
     EXPECT_EQ(hitOf(*again), hitOf(*fresh));
 }
 
+// A binary tree of 2^n spheres: its expansions' arrays grow with n.
+const char* kSphereTree = R"(
+{n = 11} T
+T if(n > 0, 2, 1)
+1: T -> sphere
+2: T -> {n = n-1} (move(1,0,0) uscale(0.5) T ∪ move(-1,0,0) uscale(0.5) T)
+)";
+
+// A thread keeps its build arrays from one expansion to the next, but not at the size of
+// a far larger one-off (a larger level tried once, a build refused at its visit limit):
+// after the large expansion, the next small one leaves the thread with small arrays.
+TEST(ExpandedInstances, AThreadDoesNotKeepTheArraysOfAFarLargerExpansion) {
+    auto c = compile(kSphereTree);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    TraceScene scene(g, computeBounds(g), true, eagerExpansion());
+    auto [select, frame] = testing::axiomInstance(g);
+    const auto n = std::find(frame.begin(), frame.end(), 11.0);
+    ASSERT_NE(n, frame.end());
+    auto expand = [&](double levels) {
+        *n = levels;
+        return UnrolledInstance::expand(scene, select, 1, frame.data(), kRootPath, 1u << 20);
+    };
+    std::thread([&] {
+        const auto large = expand(11);
+        ASSERT_TRUE(large);
+        const size_t keptAfterLarge = UnrolledInstance::keptBuildBytes();
+        EXPECT_GE(keptAfterLarge, large->bytes() / 2);  // (the largest so far: kept)
+        const auto small = expand(3);
+        ASSERT_TRUE(small);
+        EXPECT_LT(UnrolledInstance::keptBuildBytes(), keptAfterLarge / 4);
+        const auto again = expand(3);
+        ASSERT_TRUE(again);
+        EXPECT_EQ(again->bytes(), small->bytes());
+        EXPECT_LT(UnrolledInstance::keptBuildBytes(), keptAfterLarge / 4);
+    }).join();
+}
+
 // Sixteen spheres in a row, x = a + 4b: the derivation puts a's four (b = 0..3) in one
 // union, four nested unions deep (balanced), or, as a chain of unions, one after the
 // other (x = 5k mod 16 for the k-th), so that spatial neighbours are never siblings.
