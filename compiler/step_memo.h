@@ -60,7 +60,7 @@ class StepMemoPlan {
 // doubling, if more than 1/missShare of that window's lookups missed, up to `maxBytes`.
 struct StepMemoGrowth {
     uint64_t window = 1u << 16;
-    uint32_t missShare = 8;
+    uint32_t missShare = 16;
     size_t maxBytes = size_t{2} << 20;
 };
 
