@@ -135,31 +135,48 @@ StepMemoPlan::StepMemoPlan(const Graph& g, const FixedSlots* fixed) : nodes_(g.n
 
 namespace {
 
-// The most bytes a thread's table takes: 2^entriesLog2 entries, halved until they fit. A
-// Sierpinski tetrahedron's 32-byte entries keep their 4,096 (128 KB); the growing tree's
-// 240-byte ones (a T-node's two matrices) get 1,024, not 4,096 (0.98 MB a thread, in every
-// frame of a sequence): its 48 frames at 640x480 on two threads 18.3 -> 16.7 MB of peak
-// RSS (docs/benchmarks.md, branch static).
-constexpr size_t kMaxTableBytes = size_t{256} << 10;
+// The most bytes a thread's table starts with: 2^entriesLog2 entries, halved until they
+// fit. A Sierpinski tetrahedron's 32-byte entries keep their 4,096 (128 KB); the growing
+// tree's 240-byte ones (a T-node's two matrices) get 1,024, not 4,096 (0.98 MB a thread, in
+// every frame of a sequence): its 48 frames at 640x480 on two threads 18.3 -> 16.7 MB of
+// peak RSS (docs/benchmarks.md, branch static). It hits for nearly all its steps, so its
+// table never grows (StepMemoGrowth).
+constexpr size_t kStartTableBytes = size_t{256} << 10;
 
-uint32_t entriesLog2Within(size_t stride, uint32_t entriesLog2) {
-    while (entriesLog2 > 0 && (stride * sizeof(uint64_t) << entriesLog2) > kMaxTableBytes)
-        --entriesLog2;
+uint32_t entriesLog2Within(size_t stride, uint32_t entriesLog2, size_t maxBytes) {
+    while (entriesLog2 > 0 && (stride * sizeof(uint64_t) << entriesLog2) > maxBytes) --entriesLog2;
     return entriesLog2;
 }
 
 }  // namespace
 
-StepMemo::StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2)
+StepMemo::StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2,
+                   const StepMemoGrowth& growth)
     : g_(g),
       plan_(plan),
       stride_(kKey + plan.maxReads() + plan.maxWrites()),
-      table_(stride_ << entriesLog2Within(stride_, entriesLog2)),
-      mask_(static_cast<uint32_t>(table_.size() / stride_) - 1) {
+      maxLog2_(entriesLog2Within(stride_, entriesLog2, growth.maxBytes)),
+      growth_(growth),
+      windowEnd_(growth.window) {
+    resize(std::min(maxLog2_, entriesLog2Within(stride_, entriesLog2, kStartTableBytes)));
+}
+
+void StepMemo::resize(uint32_t entriesLog2) {
+    log2_ = entriesLog2;
+    table_.assign(stride_ << entriesLog2, 0);
+    mask_ = (uint32_t{1} << entriesLog2) - 1;
     for (size_t i = 0; i < table_.size(); i += stride_) table_[i] = kNone;
 }
 
+void StepMemo::endWindow() {
+    const uint64_t missed = misses_ - windowMisses_;
+    if (log2_ < maxLog2_ && missed * growth_.missShare > growth_.window) resize(log2_ + 1);
+    windowMisses_ = misses_;
+    windowEnd_ = hits_ + misses_ + growth_.window;
+}
+
 bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, uint64_t*& e) {
+    if (hits_ + misses_ == windowEnd_) endWindow();
     uint64_t key[StepMemoPlan::kMaxReads];
     const uint32_t* reads = plan_.reads(p);
     uint64_t h = add(0, n);

@@ -56,12 +56,23 @@ class StepMemoPlan {
     uint32_t maxReads_ = 0, maxWrites_ = 0;
 };
 
-// Per thread: the table (a few thousand entries, a fixed number). An entry holds as many
-// read and written values as the plan's nodes need at most (a Sierpinski tetrahedron's
-// one slot: 32 bytes, where room for kMaxReads and kMaxWrites took 336).
+// When a thread's table grows (StepMemo's constructor): after every `window` lookups, by
+// doubling, if more than 1/missShare of that window's lookups missed, up to `maxBytes`.
+struct StepMemoGrowth {
+    uint64_t window = 1u << 16;
+    uint32_t missShare = 16;
+    size_t maxBytes = size_t{2} << 20;
+};
+
+// Per thread: the table (a few thousand entries). An entry holds as many read and written
+// values as the plan's nodes need at most (a Sierpinski tetrahedron's one slot: 32 bytes,
+// where room for kMaxReads and kMaxWrites took 336). The table starts within 256 KB and
+// grows towards 2^entriesLog2 entries while it misses often (StepMemoGrowth): the terrain's
+// 304-byte entries start at 512, where the rays missed for 48% of their steps.
 class StepMemo {
   public:
-    StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2 = 12);
+    StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2 = 12,
+             const StepMemoGrowth& growth = {});
 
     // Semantics' S-node step: the rule selected (0-based).
     uint32_t select(NodeId n, EvalState in);
@@ -83,13 +94,20 @@ class StepMemo {
     // The entry for (n, in): found (true) or to fill (false); its key gets the read values.
     bool lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, uint64_t*& e);
     uint64_t* out(uint64_t* e) const { return e + kKey + plan_.maxReads(); }
+    // At the end of a window of lookups: doubles the table (emptied) if the window missed
+    // often and the table may still grow.
+    void endWindow();
+    void resize(uint32_t entriesLog2);
 
     const Graph& g_;
     const StepMemoPlan& plan_;
     size_t stride_;
     std::vector<uint64_t> table_;
-    uint32_t mask_;
+    uint32_t mask_ = 0;
+    uint32_t log2_ = 0, maxLog2_ = 0;  // the table's entries, now and at most
+    StepMemoGrowth growth_;
     uint64_t hits_ = 0, misses_ = 0;
+    uint64_t windowEnd_ = 0, windowMisses_ = 0;  // the lookups and misses at the window's start
 };
 
 }  // namespace pcsg

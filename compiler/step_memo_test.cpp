@@ -27,10 +27,10 @@ T choose(1, 1 + a)
 2: T -> move(0, 0, rand()) cube
 )";
 
-// A frame of small values, so that the same keys come back.
-std::vector<double> randomFrame(const Graph& g, std::mt19937_64& rng) {
+// A frame of small values (below `spread`), so that the same keys come back.
+std::vector<double> randomFrame(const Graph& g, std::mt19937_64& rng, uint64_t spread) {
     std::vector<double> f(g.slotCount());
-    for (double& v : f) v = static_cast<double>(rng() % 4);
+    for (double& v : f) v = static_cast<double>(rng() % spread);
     return f;
 }
 
@@ -43,12 +43,12 @@ bool sameAffine(const Affine& a, const Affine& b) {
 }
 
 // Each step through the memo against the step computed directly, many times over.
-void checkAgainstDirect(Graph& g, StepMemo& memo, int trials) {
+void checkAgainstDirect(Graph& g, StepMemo& memo, int trials, uint64_t spread = 4) {
     std::mt19937_64 rng(7);
     const StepMemoPlan plan(g);
     std::vector<double> direct(g.slotCount()), remembered(g.slotCount());
     for (int k = 0; k < trials; ++k) {
-        const std::vector<double> frame = randomFrame(g, rng);
+        const std::vector<double> frame = randomFrame(g, rng, spread);
         const EvalState s{frame.data(), kRootPath + rng() % 3};
         g.time.clock = static_cast<double>(rng() % 2);
         for (NodeId n = 0; n < g.nodes.size(); ++n) {
@@ -174,6 +174,40 @@ S if(c > 0, 2, 1)
     const StepMemo large(*k->graph, full, 12);
     EXPECT_EQ(large.bytes(), 1024u * entryBytes);
     EXPECT_EQ(StepMemo(*k->graph, full, 9).bytes(), 512u * entryBytes);
+}
+
+// A table that misses for most of its lookups doubles at the end of each window, up to
+// 2^entriesLog2 entries and the growth's byte limit, and still gives the steps' numbers.
+TEST(StepMemo, ATableThatMissesOftenGrowsUpToItsLimit) {
+    auto c = compile(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const StepMemoPlan plan(*c->graph);
+    const size_t entryBytes = (2 + plan.maxReads() + plan.maxWrites()) * sizeof(uint64_t);
+    StepMemoGrowth growth;
+    growth.window = 1024;
+    StepMemo memo(*c->graph, plan, 12, growth);
+    EXPECT_EQ(memo.bytes(), 1024u * entryBytes);         // the start: within 256 KB
+    checkAgainstDirect(*c->graph, memo, 400, 1u << 20);  // nearly every key new
+    EXPECT_EQ(memo.bytes(), 4096u * entryBytes);
+
+    growth.maxBytes = 3000 * entryBytes;  // room for 2,048 entries, not 4,096
+    StepMemo capped(*c->graph, plan, 12, growth);
+    checkAgainstDirect(*c->graph, capped, 400, 1u << 20);
+    EXPECT_EQ(capped.bytes(), 2048u * entryBytes);
+}
+
+// A table that hits for most of its lookups keeps its size through many windows.
+TEST(StepMemo, ATableThatHitsKeepsItsSize) {
+    auto c = compile(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const StepMemoPlan plan(*c->graph);
+    StepMemoGrowth growth;
+    growth.window = 16384;
+    StepMemo memo(*c->graph, plan, 12, growth);
+    const size_t start = memo.bytes();
+    checkAgainstDirect(*c->graph, memo, 8000);                  // few distinct keys
+    EXPECT_GT(memo.hits() + memo.misses(), 4 * growth.window);  // windows were ended
+    EXPECT_EQ(memo.bytes(), start);
 }
 
 }  // namespace

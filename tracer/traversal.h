@@ -118,7 +118,8 @@ class TraceScene {
     size_t expansionBudget() const;
 
     // Each tracer remembers the results of C- and T-steps (compiler/step_memo.h) in a table
-    // of 2^stepMemoLog2 entries (of 336 bytes); 0 turns it off.
+    // of at most 2^stepMemoLog2 entries (it starts within 256 KB and grows while it misses
+    // often); 0 turns it off.
     uint32_t stepMemoLog2 = 12;
 
     // The two-level structure (top_level.h): built where it pays, in a budget of its own
