@@ -87,13 +87,14 @@ class TopLevel::Cuts final : public UnrolledInstance::Cuts {
 };
 
 std::unique_ptr<TopLevel> TopLevel::build(const TraceScene& scene, const UnrollCache& cache,
-                                          size_t maxBytes) {
+                                          size_t maxBytes, bool* manyCopies) {
     if (!scene.instanceBoxes() || maxBytes == 0) return nullptr;
     auto t = std::make_unique<TopLevel>();
     Cuts dry(scene, cache, maxBytes, *t, true);
-    if (!UnrolledInstance::expandTop(scene, dry) || dry.instances() == 0 ||
-        2 * dry.instances() > t->copies_)
-        return nullptr;
+    const bool whole = UnrolledInstance::expandTop(scene, dry) != nullptr;
+    const bool shared = dry.instances() > 0 && 2 * dry.instances() <= t->copies_;
+    if (manyCopies) *manyCopies = !whole && shared && t->copies_ > kManyCopies;
+    if (!whole || !shared) return nullptr;
     t->copies_ = 0;
     Cuts cuts(scene, cache, maxBytes, *t, false);
     t->top_ = UnrolledInstance::expandTop(scene, cuts);

@@ -52,11 +52,15 @@ class TopLevel {
     static constexpr uint64_t kMaxVisits = 1u << 13;
     static constexpr uint64_t kVisitsPerCopy = 16;
     static constexpr uint64_t kBudgetPerVisit = 512;
+    // Copies met by a refused dry run above which larger instances would help (see build).
+    static constexpr uint64_t kManyCopies = 1024;
 
     // The top level of the scene, cut where `cache` expands, or nullptr (refused, see
-    // above). Throws RuntimeError when unrolling meets a run-time error.
+    // above). `manyCopies` (if given) tells whether it was refused while its copies were
+    // many and their instances few: cut at larger instances, it would hold fewer copies.
+    // Throws RuntimeError when unrolling meets a run-time error.
     static std::unique_ptr<TopLevel> build(const TraceScene& scene, const UnrollCache& cache,
-                                           size_t maxBytes);
+                                           size_t maxBytes, bool* manyCopies = nullptr);
 
     // The nearest surface as Tracer::first from the axiom finds it (world ray).
     bool first(const LocalRay& r, double tmin, double& tmax, Hit& hit, bool anyHit,

@@ -205,11 +205,16 @@ const TopLevel* TraceScene::buildTopLevel(uint32_t maxTries) const {
     const std::unique_lock lock(topMutex_, std::try_to_lock);
     if (!lock.owns_lock() || topTries_ >= maxTries) return nullptr;
     ++topTries_;
+    bool manyCopies = false;
     try {
-        topOwned_ = TopLevel::build(*this, expansionCache(), expansionBytes);
+        topOwned_ = TopLevel::build(*this, expansionCache(), expansionBytes, &manyCopies);
     } catch (const RuntimeError&) {
         return nullptr;  // (the walk raises it where a ray meets it)
     }
+    // Too many copies of small instances (Sierpinski order 12 cut at the 256-KB instances
+    // of a 2 MB budget: 16,384 copies): the level waiting above them gets its budget, so
+    // that the next try cuts at a quarter as many copies of its larger instances.
+    if (manyCopies) expansionCache().growForWaitingLevel();
     top_.store(topOwned_.get(), std::memory_order_release);
     return topOwned_.get();
 }

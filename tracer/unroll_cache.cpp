@@ -122,6 +122,23 @@ void UnrollCache::turnOff(Yield& yield) {
     }
 }
 
+size_t UnrollCache::growForWaitingLevel() {
+    const size_t budget = this->budget();
+    Yield* smallest = nullptr;
+    for (size_t y = 0; y < scene_.graph().modules.size() * levels_; ++y) {
+        Yield& yield = yield_[y];
+        const size_t want = yield.want.load(std::memory_order_relaxed);
+        if (!yield.off.load(std::memory_order_relaxed) && yield.skipped(budget) && want > 0 &&
+            kShare * want <= maxBytes_ &&
+            (!smallest || want < smallest->want.load(std::memory_order_relaxed)))
+            smallest = &yield;
+    }
+    if (!smallest) return 0;
+    const size_t g = growTo(kShare * smallest->want.load(std::memory_order_relaxed) * 5 / 4);
+    smallest->grew.fetch_add(g, std::memory_order_relaxed);
+    return g;
+}
+
 // An evicted instance is met again while its ghost is there: whether such meetings are
 // frequent enough, of all the evictions so far, for a larger budget to pay.
 bool UnrollCache::ghostsPay() {

@@ -29,7 +29,9 @@
 //    served by one smaller expansion (and the top level's copies of it) and stays small;
 //    one whose smaller instances are many and distinct gets the larger ones. What a level's
 //    misses grew the budget by goes back when expansion stops there (its larger instances
-//    did not pay: a terrain's patches of depth 6 and 7). Ghosts grow the budget only while
+//    did not pay: a terrain's patches of depth 6 and 7). A top level refused for its
+//    many copies of small instances grows it for the waiting level too (Sierpinski
+//    order 12: growForWaitingLevel). Ghosts grow the budget only while
 //    their meetings are at least an eighth of the evictions so far (kGhostRate): a
 //    terrain's patches, met again mostly far apart, leave it below the maximum. Which budget
 //    each rule uses: eviction and an instance's share, the budget reached; the thrash
@@ -97,6 +99,12 @@ class UnrollCache {
         bool off = false;      // expansion stopped there
     };
     Level level(NodeId select, uint32_t depth) const;
+
+    // Grows the budget to hold an instance of the waiting level (too large for the budget
+    // reached, not for the maximum's share) whose instances are the smallest, as its misses
+    // would; for a top level refused for its many copies of smaller instances. Returns the
+    // growth (0: no level waits).
+    size_t growForWaitingLevel();
 
     // The instance stored under `key` if it is built (else nullptr), for a holder that keeps
     // it beyond a Pin scope (the top level): it stays valid while the holder holds it,

@@ -425,5 +425,30 @@ TEST(UnrollCache, ALevelTooLargeForTheStartWithNoStandInsLeavesTheBudgetSmall) {
     EXPECT_EQ(w.got, 0);
 }
 
+// A top level refused for its many copies of small instances asks for the waiting level
+// (TraceScene::buildTopLevel): the budget grows to hold its instances, and they expand.
+TEST(UnrollCache, TheWaitingLevelGetsItsBudgetWhenAskedFor) {
+    WaitingLevel w(1, 2000);
+    ASSERT_EQ(w.cache.budget(), 4 * w.large);
+    EXPECT_GT(w.cache.growForWaitingLevel(), 0u);
+    EXPECT_GE(w.cache.budget(), 8 * w.large);
+    EXPECT_LE(w.cache.budget(), 64 * w.large);
+    UnrollCache::Reader reader(w.cache);
+    int got = 0;
+    for (int m = 0; m < 8; ++m) {
+        const UnrollCache::Pin pin(&reader);
+        if (w.f.get(reader, 20)) ++got;
+    }
+    EXPECT_GT(got, 0);
+    EXPECT_GE(w.cache.level(w.f.select, 1).built, 1u);
+}
+
+TEST(UnrollCache, NoWaitingLevelNoGrowthWhenAskedFor) {
+    WaitingLevel w(8, 0);  // (small flowers only: nothing waits)
+    const size_t before = w.cache.budget();
+    EXPECT_EQ(w.cache.growForWaitingLevel(), 0u);
+    EXPECT_EQ(w.cache.budget(), before);
+}
+
 }  // namespace
 }  // namespace pcsg::tracer
