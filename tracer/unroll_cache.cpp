@@ -122,6 +122,16 @@ void UnrollCache::turnOff(Yield& yield) {
     }
 }
 
+// Grows the budget to hold one instance of a waiting level (and a quarter more); what it
+// grew by goes back if expansion stops there (turnOff).
+size_t UnrollCache::growFor(Yield& yield) {
+    const size_t g = growTo(kShare * yield.want.load(std::memory_order_relaxed) * 5 / 4);
+    yield.grew.fetch_add(g, std::memory_order_relaxed);
+    return g;
+}
+
+// The waiting levels are those whose instances the budget reached does not hold
+// (waitForRoom set their `want`, within the maximum's share).
 size_t UnrollCache::growForWaitingLevel() {
     const size_t budget = this->budget();
     Yield* smallest = nullptr;
@@ -129,14 +139,10 @@ size_t UnrollCache::growForWaitingLevel() {
         Yield& yield = yield_[y];
         const size_t want = yield.want.load(std::memory_order_relaxed);
         if (!yield.off.load(std::memory_order_relaxed) && yield.skipped(budget) && want > 0 &&
-            kShare * want <= maxBytes_ &&
             (!smallest || want < smallest->want.load(std::memory_order_relaxed)))
             smallest = &yield;
     }
-    if (!smallest) return 0;
-    const size_t g = growTo(kShare * smallest->want.load(std::memory_order_relaxed) * 5 / 4);
-    smallest->grew.fetch_add(g, std::memory_order_relaxed);
-    return g;
+    return smallest ? growFor(*smallest) : 0;
 }
 
 // An evicted instance is met again while its ghost is there: whether such meetings are
@@ -246,10 +252,7 @@ void UnrollCache::Reader::missed(size_t y) {
     if (yield.off.load(std::memory_order_relaxed) || ++misses_[y] < kUseBatch) return;
     const uint64_t n = yield.missed.fetch_add(misses_[y], std::memory_order_relaxed) + misses_[y];
     misses_[y] = 0;
-    if (n >= kMisses && cache_.expansions() >= kStandIns)
-        yield.grew.fetch_add(
-            cache_.growTo(kShare * yield.want.load(std::memory_order_relaxed) * 5 / 4),
-            std::memory_order_relaxed);
+    if (n >= kMisses && cache_.expansions() >= kStandIns) cache_.growFor(yield);
 }
 
 const UnrolledInstance* UnrollCache::Reader::built(const InstanceBoxes::Key& key, NodeId select,

@@ -123,6 +123,7 @@ class UnrollCache {
     double predictedBytes(NodeId select, uint32_t depth, double maxPerVisit = 1e300) const;
     bool waitForRoom(Yield& yield, size_t bytes);
     size_t growTo(size_t bytes);
+    size_t growFor(Yield& yield);
     void turnOff(Yield& yield);
     void unghost(Entry& e);
     bool stopsAt(size_t y, NodeId select, uint32_t depth, size_t ghost, uint32_t pendingUses);
