@@ -88,25 +88,25 @@ inline int enterChildrenBelow(const UnrolledInstance::BvhNode& b, const LocalRay
 // A ray in floats for enterChildrenFloat, made once per walk of a hierarchy: `ok` only
 // where the float test's error bound holds (no zero axis; the float origin and 1/d with
 // |o| < 2^60 and 2^-60 < |1/d| < 2^60, so that no float product is a NaN and the margin
-// is finite), else the walk takes enterChildren. It carries the widening's constants
-// (kFloatSlabs) too: the walk keeps them beside the ray, operands of the test's
-// instructions, instead of broadcasting each from a scalar at every node.
+// is finite), else the walk takes enterChildren.
 struct FloatRay {
     __m128 o[3], inv[3];
     __m128 tmin, margin;
-    __m128 down, up, max, lowest;
     bool ok = false;
 };
 
-// The constants of enterChildrenFloat (in memory, operands of its instructions).
+// The constants of enterChildrenFloat's widening, operands in memory of its instructions.
+// Defined in bvh_slabs.cpp, out of the compiler's sight: with their values known, GCC
+// broadcast each from a scalar at every node (the walk's calls leave no register to keep
+// them in), and copying them into every walk's FloatRay cost ~16 instructions a walk.
 struct alignas(16) FloatSlabConstants {
     float down[4], up[4], max[4], lowest[4];
+    // floatRay's: its checks' bounds (2^60, 2^-60), the margin's factor and floor (2^-21,
+    // 2^-120), and the mask of a float's magnitude
+    float big[4], small[4], reachFactor[4], floor[4];
+    uint32_t magnitude[4];
 };
-inline constexpr FloatSlabConstants kFloatSlabs{
-    {1 - 0x1p-19f, 1 - 0x1p-19f, 1 - 0x1p-19f, 1 - 0x1p-19f},
-    {1 + 0x1p-19f, 1 + 0x1p-19f, 1 + 0x1p-19f, 1 + 0x1p-19f},
-    {FLT_MAX, FLT_MAX, FLT_MAX, FLT_MAX},
-    {-FLT_MAX, -FLT_MAX, -FLT_MAX, -FLT_MAX}};
+extern const FloatSlabConstants kFloatSlabs;
 
 // The error bound: for a slab bound t = (lo - o) / d, the float origin is off by at most
 // 2^-24 |o|, and the difference, 1/d and the product by 2^-24 of theirs, so the float
@@ -123,17 +123,18 @@ inline FloatRay floatRay(const LocalRay& r, double tmin) {
         _mm_movelh_ps(_mm_cvtpd_ps(_mm_loadu_pd(&r.o.x)), _mm_cvtpd_ps(_mm_set_sd(r.o.z)));
     const __m128 iv =
         _mm_movelh_ps(_mm_cvtpd_ps(_mm_loadu_pd(&inv.x)), _mm_cvtpd_ps(_mm_set_sd(inv.z)));
-    const __m128 magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    const FloatSlabConstants& k = kFloatSlabs;
+    const __m128 magnitude = _mm_load_ps(reinterpret_cast<const float*>(k.magnitude));
     const __m128 ao = _mm_and_ps(o, magnitude), ai = _mm_and_ps(iv, magnitude);
-    const __m128 big = _mm_set1_ps(0x1p60f);
+    const __m128 big = _mm_load_ps(k.big);
     const __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmplt_ps(ao, big), _mm_cmplt_ps(ai, big)),
-                                 _mm_cmpgt_ps(ai, _mm_set1_ps(0x1p-60f)));
+                                 _mm_cmpgt_ps(ai, _mm_load_ps(k.small)));
     if ((_mm_movemask_ps(in) & 7) != 7) return f;  // (a NaN fails too)
     __m128 reach = _mm_mul_ps(ao, ai);             // (the fourth lane 0)
     reach = _mm_max_ps(reach, _mm_shuffle_ps(reach, reach, _MM_SHUFFLE(2, 3, 0, 1)));
     reach = _mm_max_ps(reach, _mm_movehl_ps(reach, reach));
     reach = _mm_shuffle_ps(reach, reach, 0);
-    f.margin = _mm_add_ps(_mm_mul_ps(reach, _mm_set1_ps(0x1p-21f)), _mm_set1_ps(0x1p-120f));
+    f.margin = _mm_add_ps(_mm_mul_ps(reach, _mm_load_ps(k.reachFactor)), _mm_load_ps(k.floor));
     f.o[0] = _mm_shuffle_ps(o, o, 0x00);
     f.o[1] = _mm_shuffle_ps(o, o, 0x55);
     f.o[2] = _mm_shuffle_ps(o, o, 0xaa);
@@ -141,9 +142,6 @@ inline FloatRay floatRay(const LocalRay& r, double tmin) {
     f.inv[1] = _mm_shuffle_ps(iv, iv, 0x55);
     f.inv[2] = _mm_shuffle_ps(iv, iv, 0xaa);
     f.tmin = _mm_set1_ps(static_cast<float>(tmin));
-    const FloatSlabConstants& k = kFloatSlabs;
-    f.down = _mm_load_ps(k.down), f.up = _mm_load_ps(k.up);
-    f.max = _mm_load_ps(k.max), f.lowest = _mm_load_ps(k.lowest);
     f.ok = true;
     return f;
 }
@@ -161,10 +159,12 @@ inline int enterChildrenFloat(const UnrolledInstance::BvhNode& b, const FloatRay
         lo = _mm_max_ps(_mm_min_ps(y, x), lo);
         hi = _mm_min_ps(_mm_max_ps(x, y), hi);
     }
-    lo = _mm_sub_ps(_mm_min_ps(_mm_mul_ps(lo, f.down), _mm_mul_ps(lo, f.up)), f.margin);
-    hi = _mm_add_ps(_mm_max_ps(_mm_mul_ps(hi, f.down), _mm_mul_ps(hi, f.up)), f.margin);
-    lo = _mm_min_ps(lo, f.max);
-    hi = _mm_max_ps(hi, f.lowest);
+    const FloatSlabConstants& k = kFloatSlabs;
+    const __m128 down = _mm_load_ps(k.down), up = _mm_load_ps(k.up);
+    lo = _mm_sub_ps(_mm_min_ps(_mm_mul_ps(lo, down), _mm_mul_ps(lo, up)), f.margin);
+    hi = _mm_add_ps(_mm_max_ps(_mm_mul_ps(hi, down), _mm_mul_ps(hi, up)), f.margin);
+    lo = _mm_min_ps(lo, _mm_load_ps(k.max));
+    hi = _mm_max_ps(hi, _mm_load_ps(k.lowest));
     _mm_storeu_ps(t0, lo);
     const __m128i empty = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(b.child)),
                                           _mm_set1_epi32(-1));

@@ -96,5 +96,31 @@ TEST(MapRay, TheDirectionIsNotTranslated) {
     EXPECT_TRUE(std::signbit(out.d.x));
 }
 
+// LocalRay::inverse and hasZeroAxis (operators.h, in SSE2 where there is SSE2) against their
+// definition: 1 / d per axis, bit for bit, and a zero axis where some component is +0 or
+// -0 (not a NaN). Directions of random entries (zeros of either sign, subnormals,
+// infinities and NaNs among them), and every axis zero alone.
+TEST(LocalRay, InverseAndZeroAxisAreTheirDefinition) {
+    std::mt19937_64 g(15);
+    const auto check = [](const Vec3& d) {
+        const LocalRay r{{1, 2, 3}, d};
+        const Vec3 inv = r.inverse();
+        const Vec3 want{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
+        for (int a = 0; a < 3; ++a)
+            EXPECT_EQ(std::bit_cast<uint64_t>(inv[a]), std::bit_cast<uint64_t>(want[a])) << a;
+        EXPECT_EQ(r.hasZeroAxis(), d.x == 0 || d.y == 0 || d.z == 0)
+            << d.x << " " << d.y << " " << d.z;
+    };
+    for (int k = 0; k < 100000; ++k) check({randomEntry(g), randomEntry(g), randomEntry(g)});
+    for (int a = 0; a < 3; ++a) {
+        for (double zero : {0.0, -0.0}) {
+            Vec3 d{0.5, -2, 3};
+            (a == 0 ? d.x : a == 1 ? d.y : d.z) = zero;
+            check(d);
+        }
+    }
+    check({0.5, -2, 3});
+}
+
 }  // namespace
 }  // namespace pcsg::tracer

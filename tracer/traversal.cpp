@@ -290,13 +290,6 @@ void Tracer::checkStackLimit(uintptr_t here) {
 }
 
 bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
-    frames_.reset();
-    spans_.clear();
-    order_.clear();
-    paintRays_.clear();
-    paintInteriors_.clear();
-    paintMaps_.clear();
-    inverses_.clear();
     if (g_.axiom == kNone) return false;
     const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
@@ -306,6 +299,15 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     if (const TopLevel* top = topLevel()) {
         if (!top->first(r, tmin, best, hit, anyHit_, expansion_->scratch())) return false;
     } else {
+        // The graph walk's own stacks (the top level's walk keeps its state in the
+        // expansions' scratch, and its hits have no paint frame of the graph walk's).
+        frames_.reset();
+        spans_.clear();
+        order_.clear();
+        paintRays_.clear();
+        paintInteriors_.clear();
+        paintMaps_.clear();
+        inverses_.clear();
         if (anyHit_ && expansion_ &&
             occluder_.occludes(*expansion_, g_.scene.settings.maxDepth, r, tmin, tmax))
             return true;
