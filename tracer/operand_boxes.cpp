@@ -13,4 +13,10 @@ OperandBoxes::Entry& OperandBoxes::slot(const InstanceBoxes::Key& k) {
     return e;
 }
 
+void OperandBoxes::computed(uint32_t depth) {
+    if (depth >= trials_.size()) trials_.resize(depth + 1);
+    Trial& t = trials_[depth];
+    if (++t.computed == kTrial) t.off = t.found < kReuse * kTrial;
+}
+
 }  // namespace pcsg::tracer

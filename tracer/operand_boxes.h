@@ -13,6 +13,15 @@
 // the next rays through that instance cull its operands before they step into them, and
 // meet the remaining ones front to back by their entry into boxes that fit them.
 //
+// An instance's boxes pay only if rays come back to it: computing them takes each operand's
+// C-step (which then misses the step memo) and box, where a ray that walks the instance
+// once takes only those of the operands its own tests do not cull. So the table watches,
+// per depth, how often its boxes are found per computation: after kTrial computations at
+// a depth, a depth where they were found fewer than kReuse times each is left to the
+// operands' static boxes (the terrain at 160x120: its instances of 4 and 16 triangles, met
+// by about one ray each; at 320x240 the depths it expands, whose instances the walk meets
+// once before they are built).
+//
 // Direct-mapped by the instance's key: a hit is the boxes any thread would compute for
 // that instance (they are a function of its key), so which rays filled the table never
 // changes what a box culls beyond what the operand's own tests would. Memory is taken on
@@ -53,10 +62,25 @@ class OperandBoxes {
     }
     size_t bytes() const { return table_.size() * sizeof(Entry); }
 
+    // The trial per depth (see above): whether to keep boxes for instances at `depth`, and
+    // the note of a find or a computation there.
+    static constexpr uint32_t kTrial = 256, kReuse = 4;
+    bool wanted(uint32_t depth) const { return depth >= trials_.size() || !trials_[depth].off; }
+    void found(uint32_t depth) {
+        if (depth >= trials_.size()) trials_.resize(depth + 1);
+        ++trials_[depth].found;
+    }
+    void computed(uint32_t depth);
+
   private:
     uint32_t entriesLog2_;
     uint64_t mask_ = 0;
     std::vector<Entry> table_;
+    struct Trial {
+        uint32_t computed = 0, found = 0;
+        bool off = false;
+    };
+    std::vector<Trial> trials_;
 };
 
 }  // namespace pcsg::tracer

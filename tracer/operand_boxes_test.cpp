@@ -33,5 +33,20 @@ TEST(OperandBoxes, FindsAnEntryOnlyOnceKeptAndOnlyForItsInstance) {
     EXPECT_EQ(t.find(3, k, 5), nullptr);
 }
 
+TEST(OperandBoxes, ADepthWhoseBoxesAreSeldomFoundIsLeftToTheStaticBoxes) {
+    OperandBoxes t;
+    for (uint32_t k = 0; k < OperandBoxes::kTrial; ++k) {
+        EXPECT_TRUE(t.wanted(3));
+        EXPECT_TRUE(t.wanted(4));
+        for (uint32_t r = 0; r < OperandBoxes::kReuse; ++r) t.found(4);
+        t.found(3);
+        t.computed(3);
+        t.computed(4);
+    }
+    EXPECT_FALSE(t.wanted(3));  // found once per computation
+    EXPECT_TRUE(t.wanted(4));   // kReuse times
+    EXPECT_TRUE(t.wanted(5));   // (not tried)
+}
+
 }  // namespace
 }  // namespace pcsg::tracer

@@ -408,9 +408,14 @@ const OperandBoxes::Entry* Tracer::operandBoxesOf(NodeId select, const InstanceB
                                                   uint32_t depth, const Step& st) {
     const Node& u = g_.nodes[st.child];
     if (!scene_.operandBoxes || u.kind != NodeKind::Operator || u.op() != CsgOp::Union ||
-        u.childCount > OperandBoxes::kMaxOperands || scene_.unionLeads[st.child] != 0)
+        u.childCount > OperandBoxes::kMaxOperands || scene_.unionLeads[st.child] != 0 ||
+        !operandBoxes_.wanted(depth))
         return nullptr;
-    if (const OperandBoxes::Entry* e = operandBoxes_.find(select, key, depth)) return e;
+    if (const OperandBoxes::Entry* e = operandBoxes_.find(select, key, depth)) {
+        operandBoxes_.found(depth);
+        return e;
+    }
+    operandBoxes_.computed(depth);
     OperandBoxes::Entry& e = operandBoxes_.slot(key);
     try {
         for (uint32_t i = 0; i < u.childCount; ++i) e.box[i] = operandBox(st.child, i, st.state);
