@@ -705,6 +705,22 @@ TEST(Traversal, UnionLeadsAreThePrimitivesBesideSubGraphs) {
     EXPECT_EQ(leadsOf("{a = rand()} (move(0, 0, a) sphere ∪ cube)"), std::vector<uint32_t>{2});
 }
 
+// The first hits (and any hits) of tracers a and b along the ray agree; a's first hit in `ha`,
+// and whether there was one.
+bool expectSameHits(Tracer& a, Tracer& b, const Vec3& o, const Vec3& d, SurfaceHit& ha) {
+    const std::string ray = vecText(o) + " towards " + vecText(d);
+    SurfaceHit hb;
+    const bool fa = a.firstHit(o, d, 1e-4, 1e7, ha), fb = b.firstHit(o, d, 1e-4, 1e7, hb);
+    EXPECT_EQ(fa, fb) << ray;
+    EXPECT_EQ(a.anyHit(o, d, 1e-4, 1e7), b.anyHit(o, d, 1e-4, 1e7)) << ray;
+    if (!fa || !fb) return false;
+    EXPECT_EQ(ha.t, hb.t) << ray;
+    EXPECT_EQ(ha.normal, hb.normal) << ray;
+    EXPECT_EQ(ha.material, hb.material) << ray;
+    EXPECT_EQ(ha.path, hb.path) << ray;
+    return true;
+}
+
 TEST(Traversal, UnionLeadsGiveTheSameHitsWithFewerVisits) {
     auto c = compile(kSeaBeside);
     ASSERT_TRUE(c->graph);
@@ -721,15 +737,8 @@ TEST(Traversal, UnionLeadsGiveTheSameHitsWithFewerVisits) {
         const Vec3 o{0.2 + u(rng) * 1.5, 0.1 + u(rng) * 1.5, 2 + u(rng)};
         const Vec3 d =
             normalize(Vec3{u(rng) * 0.3 - (o.x - 0.2) * 0.2, u(rng) * 0.3 - (o.y - 0.1) * 0.2, -1});
-        const std::string ray = vecText(o) + " towards " + vecText(d);
-        SurfaceHit ha, hb;
-        const bool fa = a.firstHit(o, d, 1e-4, 1e7, ha), fb = b.firstHit(o, d, 1e-4, 1e7, hb);
-        ASSERT_EQ(fa, fb) << ray;
-        EXPECT_EQ(a.anyHit(o, d, 1e-4, 1e7), b.anyHit(o, d, 1e-4, 1e7)) << ray;
-        if (!fa) continue;
-        EXPECT_EQ(ha.t, hb.t) << ray;
-        EXPECT_EQ(ha.normal, hb.normal) << ray;
-        EXPECT_EQ(ha.material, hb.material) << ray;
+        SurfaceHit ha;
+        if (!expectSameHits(a, b, o, d, ha)) continue;
         ++(g.materials[ha.material].color.z == 1 ? planeHits : landHits);  // sea: blue
     }
     EXPECT_GT(planeHits, kRays / 4);
@@ -774,16 +783,8 @@ TEST(Traversal, OperandBoxesGiveTheSameHitsWithFewerVisits) {
         // (low over the terrain, as a landscape's camera sees it)
         const Vec3 o{0.5 + u(rng) * 2, -1.5 + u(rng) * 0.5, 0.6 + u(rng) * 0.3};
         const Vec3 d = normalize(Vec3{u(rng) * 0.4, 1, -0.35 + u(rng) * 0.2});
-        const std::string ray = vecText(o) + " towards " + vecText(d);
-        SurfaceHit ha, hb;
-        const bool fa = a.firstHit(o, d, 1e-4, 1e7, ha), fb = b.firstHit(o, d, 1e-4, 1e7, hb);
-        ASSERT_EQ(fa, fb) << ray;
-        EXPECT_EQ(a.anyHit(o, d, 1e-4, 1e7), b.anyHit(o, d, 1e-4, 1e7)) << ray;
-        if (!fa) continue;
-        ++hits;
-        EXPECT_EQ(ha.t, hb.t) << ray;
-        EXPECT_EQ(ha.normal, hb.normal) << ray;
-        EXPECT_EQ(ha.path, hb.path) << ray;
+        SurfaceHit ha;
+        hits += expectSameHits(a, b, o, d, ha);
     }
     EXPECT_GT(hits, kRays / 8);
     // The operands a ray's box misses are no longer stepped into.
