@@ -44,9 +44,9 @@ void addReads(const Graph& g, ExprId id, std::vector<uint32_t>& reads, bool& use
 }
 
 double readValue(const Graph& g, uint32_t r, const double* frame) {
-    if (r == StepMemoPlan::kClock) return g.time.clock;
-    if (r == StepMemoPlan::kFrame) return g.time.frame;
-    return frame[r];
+    if (r < StepMemoPlan::kFrame) [[likely]]  // (one test for the two time reads)
+        return frame[r];
+    return r == StepMemoPlan::kClock ? g.time.clock : g.time.frame;
 }
 
 // Doubles differ in their high bits (exponent and leading mantissa), so each value is

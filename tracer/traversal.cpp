@@ -350,11 +350,11 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
 // walks on from the node the step leads to; `unrolled(x, state)` traces an unrolled
 // instance instead; `transformBack(inv, walkBelow)` runs the walk below a T-node and
 // brings the normals it found back through the T-node.
-template <class Below, class Unrolled, class TransformBack>
+template <bool kOperands, class Below, class Unrolled, class TransformBack>
 [[gnu::always_inline]] inline auto Tracer::unary(NodeId n, const LocalRay& r, const Ctx& c,
                                                  double tmin, double tmax, Below below,
                                                  Unrolled unrolled, TransformBack transformBack) {
-    using Result = decltype(below(n, r, c));
+    using Result = decltype(below(n, r, c, nullptr));
     const Semantics& sem = scene_.sem_;
     const NodeKind kind = g_.nodes[n].kind;
     StepScratch scratch;
@@ -370,7 +370,9 @@ template <class Below, class Unrolled, class TransformBack>
             if (exactCulled(n, r, c, depth, t0, t1, key)) return Result{};
             if (const UnrolledInstance* x = unrolledAt(n, c, depth, key)) return unrolled(*x, c);
             const Step st = sem.enter(n, c, scratch);
-            return below(st.child, r, st.state);
+            const OperandBoxes::Entry* operands =
+                kOperands && key ? operandBoxesOf(n, *key, depth, st) : nullptr;
+            return below(st.child, r, st.state, operands);
         } catch (RuntimeError& e) {
             e.enterModule(g_.modules[g_.nodes[n].payload].name);
             throw;
@@ -389,13 +391,75 @@ template <class Below, class Unrolled, class TransformBack>
     if (st.inverse) {
         const LocalRay rr{st.inverse->point(r.o), st.inverse->vector(r.d)};
         if (scene_.paintMaps || anyHit_) inverses_.push_back(st.inverse);
-        found = transformBack(*st.inverse, [&] { return below(st.child, rr, st.state); });
+        found = transformBack(*st.inverse, [&] { return below(st.child, rr, st.state, nullptr); });
         if (scene_.paintMaps || anyHit_) inverses_.pop_back();
     } else {
-        found = below(st.child, r, st.state);
+        found = below(st.child, r, st.state, nullptr);
     }
     if (kind == NodeKind::Calc) frames_.pop();
     return found;
+}
+
+// The boxes of the operands of the union that S-node instance (select, key) at `depth` leads
+// to by its step `st`, each in the union's frame (operand_boxes.h): computed on the first
+// visit of the instance, then found. Null where the step leads to no union of at most
+// kMaxOperands operands, or computing a box threw (the walk meets the error itself, where a
+// ray reaches it). Not for a union with leading operands either: firstOfUnion walks them
+// before it tests the others' boxes, and that walk may reuse this entry's slot.
+const OperandBoxes::Entry* Tracer::operandBoxesOf(NodeId select, const InstanceBoxes::Key& key,
+                                                  uint32_t depth, const Step& st) {
+    const Node& u = g_.nodes[st.child];
+    if (!scene_.operandBoxes || u.kind != NodeKind::Operator || u.op() != CsgOp::Union ||
+        u.childCount > OperandBoxes::kMaxOperands || scene_.unionLeads[st.child] != 0 ||
+        !operandBoxes_.wanted(depth))
+        return nullptr;
+    if (const OperandBoxes::Entry* e = operandBoxes_.find(select, key, depth)) {
+        operandBoxes_.found(depth);
+        return e;
+    }
+    operandBoxes_.computed(depth);
+    OperandBoxes::Entry& e = operandBoxes_.slot(key);
+    try {
+        for (uint32_t i = 0; i < u.childCount; ++i) e.box[i] = operandBox(st.child, i, st.state);
+    } catch (const RuntimeError&) {
+        return nullptr;
+    }
+    OperandBoxes::keep(e, select, key, depth);
+    return &e;
+}
+
+// Operand i of union u (entered in state cu): its box in the union's frame. An operand that
+// is a chain of unary steps down to an S-node gets that S-node instance's box (its exact box
+// where the instance boxes are used at its depth, else its static box there) mapped up by
+// the chain's matrices and padded again for their rounding, so that it holds whatever the
+// walk below would find; any other operand its static box, as the union tests it without.
+Box Tracer::operandBox(NodeId u, uint32_t i, const Ctx& cu) {
+    NodeId m = g_.child(u, i);
+    Ctx c = Semantics::operand(cu, i);
+    Affine up = Affine::identity();
+    StepScratch scratch;
+    scratch.memo = memo_.get();
+    struct Frames {  // the C-steps' frames, popped however the chain ends
+        FrameStack& stack;
+        uint32_t pushed = 0;
+        ~Frames() {
+            while (pushed--) stack.pop();
+        }
+    } frames{frames_};
+    for (NodeKind kind; (kind = g_.nodes[m].kind) != NodeKind::Select;) {
+        if (kind == NodeKind::Operator || kind == NodeKind::Primitive)
+            return scene_.bounds_.node[g_.child(u, i)];
+        if (kind == NodeKind::Calc) scratch.frame = frames_.push(), ++frames.pushed;
+        const Step st = scene_.sem_.enter(m, c, scratch);
+        if (st.forward) up = up * *st.forward;
+        m = st.child, c = st.state;
+    }
+    const uint32_t depth = scene_.sem_.selectDepth(m, c);
+    const InstanceBoxes* boxes = scene_.instanceBoxes_.get();
+    const Box b = boxes && boxes->useAt(m, depth)
+                      ? boxes->box(*boxWorker_, m, depth, c.frame, c.path)
+                      : scene_.bounds_.select(g_, m, depth);
+    return paddedBox(transformBox(up, b));
 }
 
 // The map from the world into the frame of the paint node being visited, for a material
@@ -417,7 +481,8 @@ bool Tracer::firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin
     return found;
 }
 
-bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit) {
+bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit,
+                   const OperandBoxes::Entry* operands) {
     ++visits_;
     const Node& node = g_.nodes[n];
     switch (node.kind) {
@@ -425,10 +490,11 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
         case NodeKind::Calc:
         case NodeKind::Transform:
         case NodeKind::Paint:
-            return unary(
+            return unary<true>(
                 n, r, c, tmin, tmax,
-                [&](NodeId below, const LocalRay& rr, const Ctx& cc) {
-                    return first(below, rr, cc, tmin, tmax, hit);
+                [&](NodeId below, const LocalRay& rr, const Ctx& cc,
+                    const OperandBoxes::Entry* ops) {
+                    return first(below, rr, cc, tmin, tmax, hit, ops);
                 },
                 [&](const UnrolledInstance& x, const Ctx& cc) {
                     if (anyHit_ && occluder_.missed(cc.path)) return false;
@@ -448,8 +514,9 @@ bool Tracer::first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, doubl
                 node.childCount, tmin, tmax, hit, anyHit_, order_,
                 [&](uint32_t i, double& t0) {
                     double t1 = tmax;
-                    return !scene_.useBounds ||
-                           clipToBox(scene_.bounds_.node[g_.child(n, i)], r, t0, t1);
+                    const Box& b =
+                        operands ? operands->box[i] : scene_.bounds_.node[g_.child(n, i)];
+                    return !scene_.useBounds || clipToBox(b, r, t0, t1);
                 },
                 [&](uint32_t i, double& best, Hit& h) {
                     return first(g_.child(n, i), r, Semantics::operand(c, i), tmin, best, h);
@@ -500,9 +567,9 @@ size_t Tracer::spans(NodeId n, const LocalRay& r, const Ctx& c, double tmin, dou
         case NodeKind::Calc:
         case NodeKind::Transform:
         case NodeKind::Paint:
-            return unary(
+            return unary<false>(
                 n, r, c, tmin, tmax,
-                [&](NodeId below, const LocalRay& rr, const Ctx& cc) {
+                [&](NodeId below, const LocalRay& rr, const Ctx& cc, const OperandBoxes::Entry*) {
                     return spans(below, rr, cc, tmin, tmax);
                 },
                 [&](const UnrolledInstance& x, const Ctx& cc) {

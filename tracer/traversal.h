@@ -58,6 +58,7 @@
 #include "graph.h"
 #include "instance_boxes.h"
 #include "last_occluder.h"
+#include "operand_boxes.h"
 #include "operators.h"
 #include "primitives.h"
 #include "semantics.h"
@@ -125,6 +126,10 @@ class TraceScene {
     // The two-level structure (top_level.h): built where it pays, in a budget of its own
     // as large as the expansion cache's (expansionBytes 0 turns it off too).
     bool twoLevel = true;
+    // First-hit rays cull a union's operands by their boxes per instance of the S-node
+    // whose rule is the union (operand_boxes.h) where the instance boxes are used; false:
+    // by the operands' static boxes alone (tests compare the two).
+    bool operandBoxes = true;
     // It, once built (nullptr: not yet, or refused).
     const TopLevel* topLevel() const { return top_.load(std::memory_order_acquire); }
     // Builds it now, unless another thread is building it or it was tried `maxTries` times
@@ -241,7 +246,8 @@ class Tracer {
         size_t slot_;
     };
 
-    bool first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit);
+    bool first(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax, Hit& hit,
+               const OperandBoxes::Entry* operands = nullptr);
     bool firstOfPrimitive(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
                           Hit& hit);
     bool firstOfSolid(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double& tmax,
@@ -254,7 +260,10 @@ class Tracer {
                                     std::optional<InstanceBoxes::Key>& key);
     const UnrolledInstance* unrolledAt(NodeId n, const Ctx& c, uint32_t depth,
                                        std::optional<InstanceBoxes::Key>& key);
-    template <class Below, class Unrolled, class TransformBack>
+    const OperandBoxes::Entry* operandBoxesOf(NodeId select, const InstanceBoxes::Key& key,
+                                              uint32_t depth, const Step& st);
+    Box operandBox(NodeId u, uint32_t i, const Ctx& cu);
+    template <bool kOperands, class Below, class Unrolled, class TransformBack>
     auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
                Unrolled unrolled, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
@@ -272,6 +281,7 @@ class Tracer {
     FrameStack frames_;
     InstanceBoxes::WorkerPtr boxWorker_;
     std::unique_ptr<StepMemo> memo_;  // null: scene_.stepMemoLog2 is 0
+    OperandBoxes operandBoxes_;
     std::unique_ptr<UnrollCache::Reader> expansion_;
     std::vector<double> rootFrame_;
     std::vector<Span> spans_;

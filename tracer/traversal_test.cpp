@@ -705,6 +705,22 @@ TEST(Traversal, UnionLeadsAreThePrimitivesBesideSubGraphs) {
     EXPECT_EQ(leadsOf("{a = rand()} (move(0, 0, a) sphere ∪ cube)"), std::vector<uint32_t>{2});
 }
 
+// The first hits (and any hits) of tracers a and b along the ray agree; a's first hit in `ha`,
+// and whether there was one.
+bool expectSameHits(Tracer& a, Tracer& b, const Vec3& o, const Vec3& d, SurfaceHit& ha) {
+    const std::string ray = vecText(o) + " towards " + vecText(d);
+    SurfaceHit hb;
+    const bool fa = a.firstHit(o, d, 1e-4, 1e7, ha), fb = b.firstHit(o, d, 1e-4, 1e7, hb);
+    EXPECT_EQ(fa, fb) << ray;
+    EXPECT_EQ(a.anyHit(o, d, 1e-4, 1e7), b.anyHit(o, d, 1e-4, 1e7)) << ray;
+    if (!fa || !fb) return false;
+    EXPECT_EQ(ha.t, hb.t) << ray;
+    EXPECT_EQ(ha.normal, hb.normal) << ray;
+    EXPECT_EQ(ha.material, hb.material) << ray;
+    EXPECT_EQ(ha.path, hb.path) << ray;
+    return true;
+}
+
 TEST(Traversal, UnionLeadsGiveTheSameHitsWithFewerVisits) {
     auto c = compile(kSeaBeside);
     ASSERT_TRUE(c->graph);
@@ -721,21 +737,57 @@ TEST(Traversal, UnionLeadsGiveTheSameHitsWithFewerVisits) {
         const Vec3 o{0.2 + u(rng) * 1.5, 0.1 + u(rng) * 1.5, 2 + u(rng)};
         const Vec3 d =
             normalize(Vec3{u(rng) * 0.3 - (o.x - 0.2) * 0.2, u(rng) * 0.3 - (o.y - 0.1) * 0.2, -1});
-        const std::string ray = vecText(o) + " towards " + vecText(d);
-        SurfaceHit ha, hb;
-        const bool fa = a.firstHit(o, d, 1e-4, 1e7, ha), fb = b.firstHit(o, d, 1e-4, 1e7, hb);
-        ASSERT_EQ(fa, fb) << ray;
-        EXPECT_EQ(a.anyHit(o, d, 1e-4, 1e7), b.anyHit(o, d, 1e-4, 1e7)) << ray;
-        if (!fa) continue;
-        EXPECT_EQ(ha.t, hb.t) << ray;
-        EXPECT_EQ(ha.normal, hb.normal) << ray;
-        EXPECT_EQ(ha.material, hb.material) << ray;
+        SurfaceHit ha;
+        if (!expectSameHits(a, b, o, d, ha)) continue;
         ++(g.materials[ha.material].color.z == 1 ? planeHits : landHits);  // sea: blue
     }
     EXPECT_GT(planeHits, kRays / 4);
     EXPECT_GT(landHits, kRays / 20);
     // Rays that reach the plane beside or through the tetrahedra's boxes no longer walk
     // the tetrahedra below it.
+    EXPECT_LT(a.nodeVisits(), b.nodeVisits() * 9 / 10);
+}
+
+// A terrain whose sub-triangles' operands are `C-node T-nodes S-node` chains (one of them
+// rotated, one a union with a sphere, which keeps its static box), for the operands' boxes
+// per instance (operand_boxes.h).
+const char* kChainedTerrain = R"(
+{ cnt = 6; delta = 0.5; x1 = 0; y1 = 0; z1 = 0; z2 = 0.1; z3 = -0.1 } T
+T if(cnt > 0, 2, 1)
+1: T -> move(0,0,z1) zshear(z2-z1, z3-z1) tri1
+2: T -> {cnt = cnt-1; z2 = (z1+z2)/2 + (rand(x1*7+y1*3) - 0.5)*delta; delta = delta*0.5}
+          scale(0.5,0.5,1) T ∪
+        {cnt = cnt-1; x1 = x1 + 0.5; z3 = (z1+z3)/2 + (rand(x1*5+y1*11) - 0.5)*delta}
+          move(0.5,0,0) scale(0.5,0.5,1) rotz(3) T ∪
+        {cnt = cnt-1; x1 = x1 + 0.25; z1 = (z1+z2)/2 + (rand(x1*3+y1*5) - 0.5)*delta}
+          move(0.5,0.5,0) scale(0.5,0.5,1) T ∪
+        {cnt = cnt-1; y1 = y1 + 0.5; z1 = z1 + rand(x1+y1*13)*delta; delta = delta*0.5}
+          move(0,0.5,0) (scale(0.5,0.5,1) T ∪ move(0.1,0.1,0) uscale(0.05) sphere)
+)";
+
+TEST(Traversal, OperandBoxesGiveTheSameHitsWithFewerVisits) {
+    auto c = compile(kChainedTerrain);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    InstanceBoxOptions always;
+    always.trial = UINT32_MAX;  // (exact boxes at every depth)
+    always.minWeight = 1;
+    TraceScene boxed(g, computeBounds(g), true, always), plain(g, computeBounds(g), true, always);
+    plain.operandBoxes = false;
+    boxed.expansionBytes = plain.expansionBytes = 0;  // (visits of the graph walk alone)
+    Tracer a(boxed), b(plain);
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int hits = 0;
+    for (int k = 0; k < kRays; ++k) {
+        // (low over the terrain, as a landscape's camera sees it)
+        const Vec3 o{0.5 + u(rng) * 2, -1.5 + u(rng) * 0.5, 0.6 + u(rng) * 0.3};
+        const Vec3 d = normalize(Vec3{u(rng) * 0.4, 1, -0.35 + u(rng) * 0.2});
+        SurfaceHit ha;
+        hits += expectSameHits(a, b, o, d, ha);
+    }
+    EXPECT_GT(hits, kRays / 8);
+    // The operands a ray's box misses are no longer stepped into.
     EXPECT_LT(a.nodeVisits(), b.nodeVisits() * 9 / 10);
 }
 
