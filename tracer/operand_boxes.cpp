@@ -14,8 +14,7 @@ OperandBoxes::Entry& OperandBoxes::slot(const InstanceBoxes::Key& k) {
 }
 
 void OperandBoxes::computed(uint32_t depth) {
-    if (depth >= trials_.size()) trials_.resize(depth + 1);
-    Trial& t = trials_[depth];
+    Trial& t = trial(depth);
     if (++t.computed == kTrial) t.off = t.found < kReuse * kTrial;
 }
 

@@ -66,10 +66,7 @@ class OperandBoxes {
     // the note of a find or a computation there.
     static constexpr uint32_t kTrial = 256, kReuse = 4;
     bool wanted(uint32_t depth) const { return depth >= trials_.size() || !trials_[depth].off; }
-    void found(uint32_t depth) {
-        if (depth >= trials_.size()) trials_.resize(depth + 1);
-        ++trials_[depth].found;
-    }
+    void found(uint32_t depth) { ++trial(depth).found; }
     void computed(uint32_t depth);
 
   private:
@@ -81,6 +78,10 @@ class OperandBoxes {
         bool off = false;
     };
     std::vector<Trial> trials_;
+    Trial& trial(uint32_t depth) {
+        if (depth >= trials_.size()) trials_.resize(depth + 1);
+        return trials_[depth];
+    }
 };
 
 }  // namespace pcsg::tracer
