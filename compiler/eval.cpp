@@ -420,16 +420,20 @@ std::optional<Affine> constantTransform(TransformOp op, const double* a) {
     return m;
 }
 
-Affine transformMatrix(const Graph& g, NodeId n, EvalState s) {
+namespace {
+
+// The values of a T-node's arguments, each checked finite; and its matrix. move() and
+// zshear() of finite arguments have the determinant 1 exactly (its products of the zeros and
+// ones of the identity are exact), so they need no singularity test.
+Affine checkedTransform(const Graph& g, NodeId n, EvalState s, double* a) {
     const Transform& t = g.transforms[g.nodes[n].payload];
-    if (t.constant) return t.matrix;
-    double a[12];
     for (uint32_t i = 0; i < t.argCount; ++i) {
         const ExprId id = g.args[t.firstArg + i];
         a[i] = evalExpr(g, id, s);
         if (!std::isfinite(a[i]))
             nonFinite(g, g.exprs[id], a[i], "the transformation argument", s.frame);
     }
+    if (t.op == TransformOp::Move || t.op == TransformOp::ZShear) return makeTransform(t.op, a);
     const FileLoc loc = t.argCount ? g.exprs[g.args[t.firstArg]].loc : g.nodes[n].loc;
     if (t.op == TransformOp::Rot && a[0] == 0 && a[1] == 0 && a[2] == 0)
         throw RuntimeError(
@@ -441,6 +445,50 @@ Affine transformMatrix(const Graph& g, NodeId n, EvalState s) {
                              t.op == TransformOp::Matrix ? "matrix()" : "the transformation",
                              describeFrame(g, s.frame)));
     return m;
+}
+
+}  // namespace
+
+Affine transformMatrix(const Graph& g, NodeId n, EvalState s) {
+    const Transform& t = g.transforms[g.nodes[n].payload];
+    if (t.constant) return t.matrix;
+    double a[12];
+    return checkedTransform(g, n, s, a);
+}
+
+void transformPair(const Graph& g, NodeId n, EvalState s, Affine& forward, Affine& inverse) {
+    const Transform& t = g.transforms[g.nodes[n].payload];
+    if (t.constant) {
+        forward = t.matrix;
+        inverse = forward.inverse();
+        return;
+    }
+    double a[12];
+    forward = checkedTransform(g, n, s, a);
+    inverse = inverseOf(t.op, a, forward);
+}
+
+// Affine::inverse() of a translation by (x, y, z): the determinant and every entry of the
+// linear part are products and differences of the identity's zeros and ones, so exactly 1
+// and the identity (every zero +0); the translation is -(L t) with L the identity, whose
+// sums keep their terms 0 * x in Affine::vector's order (the signs of zeros).
+// Of zshear(a, b) (L's row 2 is (a, b, 1)): the entries that are not constant are
+// 0*b - 0, 0*a - 0 (x - +0 is x), 0*b - a and 0*a - b; L t with t = +0 adds up to +0 in
+// each row (its last term is +0, and -0 + +0 is +0), so the translation is -0.
+Affine inverseOf(TransformOp op, const double* a, const Affine& forward) {
+    if (op == TransformOp::Move) {
+        const double x = a[0], y = a[1], z = a[2];
+        return Affine::translate(
+            {-((x + 0.0 * y) + 0.0 * z), -((0.0 * x + y) + 0.0 * z), -((0.0 * x + 0.0 * y) + z)});
+    }
+    if (op == TransformOp::ZShear) {
+        Affine r;
+        r.l[0][1] = 0.0 * a[1], r.l[1][0] = 0.0 * a[0];
+        r.l[2][0] = 0.0 * a[1] - a[0], r.l[2][1] = 0.0 * a[0] - a[1];
+        r.t = {-0.0, -0.0, -0.0};
+        return r;
+    }
+    return forward.inverse();
 }
 
 void primitiveArgs(const Graph& g, NodeId n, EvalState s, double* out) {

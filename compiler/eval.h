@@ -81,6 +81,16 @@ void applyCalc(const Graph& g, NodeId calcNode, EvalState in, double* out);
 // Constant transforms return their precomputed matrix.
 Affine transformMatrix(const Graph& g, NodeId transformNode, EvalState s);
 
+// transformMatrix() and the matrix's inverse (Affine::inverse()'s doubles, bit for bit). A
+// terrain's terminating rules move() and zshear() a triangle per instance: their inverses
+// are built directly, without the general inverse (inverseOf()).
+void transformPair(const Graph& g, NodeId transformNode, EvalState s, Affine& forward,
+                   Affine& inverse);
+
+// forward.inverse() for the matrix `forward` = makeTransform(op, args): built directly for
+// move() and zshear() of finite arguments, the same doubles as the general inverse.
+Affine inverseOf(TransformOp op, const double* args, const Affine& forward);
+
 // The matrix of one transformation from its evaluated arguments (shared with tests and
 // the builder's constant folding). `args` has the count the operation takes.
 Affine makeTransform(TransformOp op, const double* args);

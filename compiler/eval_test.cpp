@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -219,6 +220,42 @@ TEST(Eval, OrderedCalcSeesEarlierAssignmentsSimultaneousDoesNot) {
     EXPECT_EQ(out[a], 2.0);
     EXPECT_EQ(out[b], 50.0);
     EXPECT_EQ(in[a], 5.0) << "the incoming frame is never changed";
+}
+
+// The bits of a matrix's twelve doubles (== would take -0 for +0).
+std::vector<uint64_t> bitsOf(const Affine& m) {
+    std::vector<uint64_t> b;
+    for (const auto& row : m.l)
+        for (double v : row) b.push_back(std::bit_cast<uint64_t>(v));
+    for (double v : {m.t.x, m.t.y, m.t.z}) b.push_back(std::bit_cast<uint64_t>(v));
+    return b;
+}
+
+TEST(Eval, MoveAndZShearInversesAreTheGeneralInversesBitForBit) {
+    std::mt19937_64 rng(13);
+    const double special[] = {0.0, -0.0, 1.0, -1.0, 0.5, -3.25, 1e-300, -4.9e-324, 1e300};
+    std::uniform_real_distribution<double> wide(-1e3, 1e3);
+    const auto arg = [&]() {
+        const uint64_t pick = rng() % 4;
+        if (pick == 0) return special[rng() % std::size(special)];
+        if (pick == 1) return std::ldexp(wide(rng), static_cast<int>(rng() % 200) - 100);
+        return wide(rng);
+    };
+    size_t signedZeros = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const double a[3] = {arg(), arg(), arg()};
+        for (TransformOp op : {TransformOp::Move, TransformOp::ZShear}) {
+            const Affine m = makeTransform(op, a);
+            const Affine direct = inverseOf(op, a, m);
+            ASSERT_EQ(bitsOf(direct), bitsOf(m.inverse()))
+                << "op " << static_cast<int>(op) << " args " << a[0] << " " << a[1] << " " << a[2];
+            for (uint64_t b : bitsOf(direct)) signedZeros += b == (uint64_t{1} << 63);
+        }
+    }
+    EXPECT_GT(signedZeros, 1000u) << "the arguments reach the inverses' negative zeros";
+    const double rot[] = {30};
+    const Affine r = makeTransform(TransformOp::RotZ, rot);
+    EXPECT_EQ(bitsOf(inverseOf(TransformOp::RotZ, rot, r)), bitsOf(r.inverse()));
 }
 
 TEST(Eval, TransformsFollowTheLanguageTable) {

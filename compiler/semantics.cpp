@@ -41,9 +41,10 @@ void Semantics::transformStep(NodeId n, const PathState& s, StepScratch& scratch
     StepScratch::Matrices& m = scratch.matrices.emplace();
     if (scratch.memo) {
         scratch.memo->transform(n, EvalState{s.frame, s.path}, m.forward, m.inverse);
-    } else {
+    } else if (scratch.forwardOnly) {
         m.forward = transformMatrix(g_, n, EvalState{s.frame, s.path});
-        if (!scratch.forwardOnly) m.inverse = m.forward.inverse();
+    } else {
+        transformPair(g_, n, EvalState{s.frame, s.path}, m.forward, m.inverse);
     }
     step.child = g_.child(n);
     step.forward = &m.forward;

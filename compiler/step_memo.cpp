@@ -229,19 +229,14 @@ void StepMemo::calc(NodeId n, EvalState in, double* frame) {
 
 void StepMemo::transform(NodeId n, EvalState in, Affine& forward, Affine& inverse) {
     const StepMemoPlan::NodePlan& p = plan_.of(n);
-    if (!p.memoised) {
-        forward = transformMatrix(g_, n, in);
-        inverse = forward.inverse();
-        return;
-    }
+    if (!p.memoised) return transformPair(g_, n, in, forward, inverse);
     uint64_t* e;
     if (lookup(n, p, in, e)) {
         fromBits(out(e), forward);
         fromBits(out(e) + 12, inverse);
         return;
     }
-    forward = transformMatrix(g_, n, in);
-    inverse = forward.inverse();
+    transformPair(g_, n, in, forward, inverse);
     toBits(forward, out(e));
     toBits(inverse, out(e) + 12);
     e[0] = n;
