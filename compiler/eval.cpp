@@ -271,7 +271,14 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
 double evalExpr(const Graph& g, ExprId id, EvalState s) {
     const Expr& e = g.exprs[id];
     double v;
-    if (e.fast != kNoFast && runFast(g, e.fast, s.frame, nullptr, s.path, v)) return v;
+    if (e.fast != kNoFast) {
+        // A lone leaf (a T-node's argument `0` or `z1`) is read without the machine's set-up.
+        const FastInstr* f = g.fastCode.data() + e.fast;
+        if (f[1].op == FastOp::End && f->op == FastOp::PushK) return f->imm;
+        if (f[1].op == FastOp::End && f->op == FastOp::PushL && !isUnassigned(s.frame[f->a]))
+            return s.frame[f->a];
+        if (runFast(g, e.fast, s.frame, nullptr, s.path, v)) return v;
+    }
     constexpr uint32_t kSmall = 64;
     if (e.maxStack <= kSmall) {
         double stack[kSmall];

@@ -190,6 +190,19 @@ TEST(FastCode, AnExpressionsFormIsLeafAndOperatorInOneInstruction) {
               "   5  Neg\n   6  AddL z\n   7  MulL x\n   8  End\n");
 }
 
+// The fast form of the i-th expression of the C-node under test.
+std::string fastFormOf(const Graph& g, uint32_t i) {
+    return dumpFastExpr(g, g.assignments[g.calcs[calcUnderTest(g)].first + i].value);
+}
+
+TEST(FastCode, ALoneLeafGivesItsValueAsTheMachineWould) {
+    auto c = withExprs({"x", "2.5", "z"});
+    ASSERT_TRUE(c->graph);
+    expectSameValues(*c->graph);
+    EXPECT_EQ(fastFormOf(*c->graph, 0), "   0  PushL x\n   1  End\n");
+    EXPECT_EQ(fastFormOf(*c->graph, 1), "   0  PushK 2.5\n   1  End\n");
+}
+
 // The error a call gives, as text ("" when it gives none).
 template <class F>
 std::string errorOf(const Graph& g, F f) {
