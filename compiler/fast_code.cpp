@@ -133,7 +133,8 @@ FastInstr plainToFast(const Instr& in) {
 }
 
 // The fast instruction for the plain code at pc: a leaf and the binary operator that takes
-// it, two leaves (a constant and a parameter) and theirs, or one instruction; returns how
+// it, two leaves (a constant and a parameter, or two parameters) and theirs, or one
+// instruction; returns how
 // many plain instructions it stands for. An operator that is a jump target is not fused.
 uint32_t fuse(const Graph& g, uint32_t pc, uint32_t end, const std::vector<uint8_t>& target,
               uint32_t begin, FastInstr& f) {
@@ -141,19 +142,26 @@ uint32_t fuse(const Graph& g, uint32_t pc, uint32_t end, const std::vector<uint8
     const auto fusable = [&](uint32_t i) {
         return i < end && binaryOf(g.code[i]) != Op::Const && !target[i - begin];
     };
-    if (isLeaf(in.op) && pc + 2 < end + 1 && isLeaf(g.code[pc + 1].op) &&
-        in.op != g.code[pc + 1].op && !target[pc + 1 - begin] && fusable(pc + 2)) {
+    const bool twoLeaves = isLeaf(in.op) && pc + 2 < end + 1 && isLeaf(g.code[pc + 1].op) &&
+                           !target[pc + 1 - begin] && fusable(pc + 2);
+    if (twoLeaves && in.op == Op::Load && g.code[pc + 1].op == Op::Load &&
+        g.code[pc + 1].a <= UINT16_MAX) {
+        f = FastInstr{binaryForm(binaryOf(g.code[pc + 2]), FastOp::AddLL), 0,
+                      static_cast<uint16_t>(g.code[pc + 1].a), in.a, 0};
+        return 3;
+    }
+    if (twoLeaves && in.op != g.code[pc + 1].op) {
         const bool constFirst = in.op == Op::Const;
         const Instr& k = constFirst ? in : g.code[pc + 1];
         const Instr& l = constFirst ? g.code[pc + 1] : in;
         f = FastInstr{
-            binaryForm(binaryOf(g.code[pc + 2]), constFirst ? FastOp::AddKL : FastOp::AddLK), 0,
+            binaryForm(binaryOf(g.code[pc + 2]), constFirst ? FastOp::AddKL : FastOp::AddLK), 0, 0,
             l.a, k.imm};
         return 3;
     }
     if (isLeaf(in.op) && fusable(pc + 1)) {
         const FastOp form = in.op == Op::Const ? FastOp::AddK : FastOp::AddL;
-        f = FastInstr{binaryForm(binaryOf(g.code[pc + 1]), form), 0, in.a, in.imm};
+        f = FastInstr{binaryForm(binaryOf(g.code[pc + 1]), form), 0, 0, in.a, in.imm};
         return 2;
     }
     f = plainToFast(in);
@@ -174,14 +182,22 @@ bool translate(Graph& g, uint32_t begin, uint32_t end, Slot held = kNone) {
         newPc[0] = static_cast<uint32_t>(g.fastCode.size());
         ++pc;
     }
+    const size_t first = g.fastCode.size();
     while (pc < end) {
         FastInstr f;
         const uint32_t n = fuse(g, pc, end, s.target, begin, f);
         for (uint32_t i = 0; i < n; ++i)
             newPc[pc + i - begin] = static_cast<uint32_t>(g.fastCode.size());
         if (f.op == FastOp::Jump || f.op == FastOp::JumpIfZero) jumps.push_back(g.fastCode.size());
-        g.fastCode.push_back(f);
         pc += n;
+        // an Add that takes a MulKL's product (no jump lands on the Add: fuse() did not
+        // fuse it, so it is not a target)
+        if (f.op == FastOp::Add && g.fastCode.size() > first &&
+            g.fastCode.back().op == FastOp::MulKL && !s.target[pc - 1 - begin]) {
+            g.fastCode.back().op = FastOp::AddMulKL;
+            continue;
+        }
+        g.fastCode.push_back(f);
     }
     newPc[end - begin] = static_cast<uint32_t>(g.fastCode.size());
     for (size_t j : jumps) g.fastCode[j].a = newPc[g.fastCode[j].a - begin];
@@ -207,7 +223,7 @@ uint32_t translateCalc(Graph& g, const Calc& c) {
             g.fastCode.resize(start);
             return kNoFast;
         }
-        g.fastCode.push_back(FastInstr{FastOp::Store, 0, as.slot});
+        g.fastCode.push_back(FastInstr{FastOp::Store, 0, 0, as.slot});
         held = c.simultaneous ? kNone : as.slot;
     }
     g.fastCode.push_back(FastInstr{FastOp::End});
@@ -232,10 +248,12 @@ std::string dumpFrom(const Graph& g, uint32_t start) {
         out += fmt::format("{:4}  {}", pc - start, kOpNames[op]);
         if (in.op == FastOp::PushK || (in.op >= FastOp::AddK && in.op <= FastOp::NeK))
             out += fmt::format(" {}", in.imm);
-        else if (in.op >= FastOp::AddKL && in.op <= FastOp::NeKL)
+        else if ((in.op >= FastOp::AddKL && in.op <= FastOp::NeKL) || in.op == FastOp::AddMulKL)
             out += fmt::format(" {} {}", in.imm, slotName(g, in.a));
         else if (in.op >= FastOp::AddLK && in.op <= FastOp::NeLK)
             out += fmt::format(" {} {}", slotName(g, in.a), in.imm);
+        else if (in.op >= FastOp::AddLL && in.op <= FastOp::NeLL)
+            out += fmt::format(" {} {}", slotName(g, in.a), slotName(g, in.b));
         else if (in.op == FastOp::PushL || in.op == FastOp::Store || in.op == FastOp::StoreKeep ||
                  (in.op >= FastOp::AddL && in.op <= FastOp::NeL))
             out += fmt::format(" {}", slotName(g, in.a));

@@ -123,13 +123,16 @@ TEST(FastCode, EachBinaryFormGivesThePlainValue) {
     std::vector<std::string> exprs, forms;
     for (size_t i = 0; i < std::size(ops); ++i) {
         const std::string op = ops[i], name = names[i];
-        exprs.insert(exprs.end(), {"(x+y) " + op + " (y*z)", "(x*y) " + op + " 2",
-                                   "(x*z) " + op + " y", "2 " + op + " y", "y " + op + " 2"});
+        exprs.insert(exprs.end(),
+                     {"(x+y) " + op + " (y*z)", "(x*y) " + op + " 2", "(x*z) " + op + " y",
+                      "2 " + op + " y", "y " + op + " 2", "z " + op + " x"});
         forms.insert(forms.end(), {"  " + name + "\n", "  " + name + "K 2\n", "  " + name + "L y\n",
-                                   "  " + name + "KL 2 y\n", "  " + name + "LK y 2\n"});
+                                   "  " + name + "KL 2 y\n", "  " + name + "LK y 2\n",
+                                   "  " + name + "LL z x\n"});
     }
-    exprs.push_back("r60 * 3");  // reads the slot the assignment before stored
-    forms.push_back("StoreKeep r60");
+    const std::string last = "r" + std::to_string(exprs.size());
+    exprs.push_back(last + " * 3");  // reads the slot the assignment before stored
+    forms.push_back("StoreKeep " + last);
     auto c = withExprs(exprs);
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
@@ -175,8 +178,8 @@ TEST(FastCode, FunctionsBranchesAndTimeGiveThePlainValue) {
     expectSameValues(*c->graph);
     const std::string dump = dumpFastCalc(*c->graph, calcUnderTest(*c->graph));
     for (const char* form :
-         {"Sin\n", "PowL y\n", "ModL y\n", "Ln\n", "Rand1\n", "PushRand0", "Call", "JumpIfZero",
-          "Jump", "ToBool", "Not\n", "Neg\n", "PushClock", "PushFrame", "Choose"})
+         {"Sin\n", "PowLL x y\n", "ModLL x y\n", "Ln\n", "Rand1\n", "PushRand0", "Call",
+          "JumpIfZero", "Jump", "ToBool", "Not\n", "Neg\n", "PushClock", "PushFrame", "Choose"})
         EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
 }
 
@@ -201,6 +204,14 @@ TEST(FastCode, ALoneLeafGivesItsValueAsTheMachineWould) {
     expectSameValues(*c->graph);
     EXPECT_EQ(fastFormOf(*c->graph, 0), "   0  PushL x\n   1  End\n");
     EXPECT_EQ(fastFormOf(*c->graph, 1), "   0  PushK 2.5\n   1  End\n");
+}
+
+TEST(FastCode, ASumOfProductsAddsEachProductInOneInstruction) {
+    auto c = withExprs({"x + 2*y + 3*z", "2*x + y*3 - 4*z", "(x + 2*y) * (1 + 3*z)"});
+    ASSERT_TRUE(c->graph);
+    expectSameValues(*c->graph);
+    EXPECT_EQ(fastFormOf(*c->graph, 0),
+              "   0  PushL x\n   1  AddMulKL 2 y\n   2  AddMulKL 3 z\n   3  End\n");
 }
 
 // The error a call gives, as text ("" when it gives none).

@@ -34,9 +34,9 @@ inline bool unassignedBits(double v) {
     } while (0)
 #define PCSG_FAST_OP(OP) op_##OP:
 
-// One binary operator in its five forms: the left operand popped, then a constant, a
-// parameter, both leaves (constant and parameter, parameter and constant). `FIX` runs after
-// the operation: for Add and Mul of two NaNs, x86 gives the first operand's NaN
+// One binary operator in its six forms: the left operand popped, then a constant, a
+// parameter, both leaves (constant and parameter, parameter and constant, two parameters). `FIX`
+// runs after the operation: for Add and Mul of two NaNs, x86 gives the first operand's NaN
 // (quietened), and the plain machine's `a + b` takes a as the first; here the compiler may
 // swap the operands of a commutative operator, so the first's NaN is restored explicitly
 // (the sign and payload of a NaN reach rand(x) and the error messages).
@@ -74,6 +74,28 @@ inline bool unassignedBits(double v) {
         st[sp++] = acc;                             \
         acc = (EXPR);                               \
         FIX;                                        \
+    }                                               \
+    PCSG_FAST_NEXT;                                 \
+    PCSG_FAST_OP(OP##LL) {                          \
+        const double a = frame[in->a];              \
+        const double b = frame[in->b];              \
+        if (unassignedBits(a)) return false;        \
+        if (unassignedBits(b)) return false;        \
+        st[sp++] = acc;                             \
+        acc = (EXPR);                               \
+        FIX;                                        \
+    }                                               \
+    PCSG_FAST_NEXT;
+// MulKL and the Add that takes its product: MulKL's value and NaN fix, then Add's.
+#define PCSG_FAST_ADD_MUL_KL                        \
+    PCSG_FAST_OP(AddMulKL) {                        \
+        const double k = in->imm, x = frame[in->a]; \
+        if (unassignedBits(x)) return false;        \
+        double p = k * x;                           \
+        if (p != p && k != k) p = k * k;            \
+        const double a = acc;                       \
+        acc = a + p;                                \
+        if (acc != acc && a != a) acc = a + a;      \
     }                                               \
     PCSG_FAST_NEXT;
 #define PCSG_FAST_FIRST_NAN(SYMBOL) \
@@ -141,6 +163,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
     PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+    PCSG_FAST_ADD_MUL_KL
     PCSG_FAST_OP(Call) {
         st[sp] = acc, sp -= in->argc - 1u;
         acc = callFunc(static_cast<Func>(in->a), st + sp, in->argc, seed);
@@ -172,6 +195,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 }
 
 #undef PCSG_FAST_BINARY
+#undef PCSG_FAST_ADD_MUL_KL
 #undef PCSG_FAST_UNARY
 #undef PCSG_FAST_PUSH
 #undef PCSG_FAST_FIRST_NAN

@@ -11,7 +11,9 @@
 // `MulL x`), and so are two leaves and their operator (`MulKL 255 x`: 255 * x); a
 // one-argument function is one instruction (`Ln`), and a C-node's assignments are one
 // program ending each value with `Store slot` (`StoreKeep` when the next value starts by
-// reading the slot just stored).
+// reading the slot just stored). Two parameters and their operator are one instruction too
+// (`AddLL z1 z2`: z1 + z2), and a product of a constant and a parameter added to acc
+// (`AddMulKL b x1`), as the terrain's seeds `a*x2 + b*x1 + c*y2 + d*y1` are sums of them.
 #pragma once
 
 #include <cstdint>
@@ -44,6 +46,10 @@ namespace pcsg {
     X(AddKL) X(SubKL) X(MulKL) X(DivKL) X(ModKL) X(PowKL) PCSG_FAST_COMPARISONS(X, KL)    \
     /* spill acc, then acc = frame[a] op imm (checked as PushL) */                        \
     X(AddLK) X(SubLK) X(MulLK) X(DivLK) X(ModLK) X(PowLK) PCSG_FAST_COMPARISONS(X, LK)    \
+    /* spill acc, then acc = frame[a] op frame[b] (checked as PushL) */                   \
+    X(AddLL) X(SubLL) X(MulLL) X(DivLL) X(ModLL) X(PowLL) PCSG_FAST_COMPARISONS(X, LL)    \
+    /* acc = acc + imm * frame[a] (checked as PushL): MulKL and the Add after it */       \
+    X(AddMulKL)                                                                           \
     /* argc values (acc the last): acc = Func a of them / choose() at call site a */      \
     X(Call)                                                                               \
     X(Choose)                                                                             \
@@ -61,6 +67,7 @@ enum class FastOp : uint8_t { PCSG_FAST_OPS(PCSG_FAST_ENUMERATOR) };
 struct FastInstr {
     FastOp op = FastOp::End;
     uint8_t argc = 0;
+    uint16_t b = 0;  // the second parameter of an OpLL form (slots below 2^16 only)
     uint32_t a = 0;
     double imm = 0;
 };
