@@ -124,6 +124,8 @@ StepMemoPlan::StepMemoPlan(const Graph& g, const FixedSlots* fixed) : nodes_(g.n
             continue;
         }
         if (reads.size() > kMaxReads) continue;
+        // the reads of clock and frame first: a lookup tests for them only until the slots
+        std::stable_partition(reads.begin(), reads.end(), [](uint32_t r) { return r >= kFrame; });
         p.firstRead = static_cast<uint32_t>(reads_.size());
         p.readCount = static_cast<uint32_t>(reads.size());
         p.memoised = true;
@@ -180,8 +182,13 @@ bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, u
     uint64_t key[StepMemoPlan::kMaxReads];
     const uint32_t* reads = plan_.reads(p);
     uint64_t h = add(0, n);
-    for (uint32_t i = 0; i < p.readCount; ++i) {
+    uint32_t i = 0;
+    for (; i < p.readCount && reads[i] >= StepMemoPlan::kFrame; ++i) {  // clock, frame first
         key[i] = bits(readValue(g_, reads[i], in.frame));
+        h = add(h, key[i]);
+    }
+    for (; i < p.readCount; ++i) {
+        key[i] = bits(in.frame[reads[i]]);
         h = add(h, key[i]);
     }
     const uint64_t path = p.usesPath ? in.path : 0;

@@ -113,6 +113,33 @@ TEST(StepMemo, TheInstancePathIsPartOfTheKeyOnlyForRandomSteps) {
     EXPECT_GE(plain, 2);
 }
 
+TEST(StepMemo, ReadsOfTheClockAfterSlotsAreKeyedFirst) {
+    // move(a, clock, b): the clock is read between two slots; the plan puts it first, and
+    // the lookup's loop over slots never takes it for one
+    auto c = compile(R"(
+{n = 3; a = 1; b = 2} S
+S if(n > 0, 2, 1)
+1: S -> sphere
+2: S -> {n = n - 1; a = a + 1; b = b * 2} move(a, frame + clock, b) S
+)");
+    ASSERT_TRUE(c->graph) << c->errors();
+    Graph& g = *c->graph;
+    const StepMemoPlan plan(g);
+    bool seen = false;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        const StepMemoPlan::NodePlan& p = plan.of(n);
+        if (g.nodes[n].kind != NodeKind::Transform || !p.memoised) continue;
+        ASSERT_EQ(p.readCount, 4u);
+        EXPECT_GE(plan.reads(p)[0], StepMemoPlan::kFrame);
+        EXPECT_GE(plan.reads(p)[1], StepMemoPlan::kFrame);
+        seen = true;
+    }
+    EXPECT_TRUE(seen);
+    StepMemo memo(g, plan);
+    checkAgainstDirect(g, memo, 200);
+    EXPECT_GT(memo.hits(), memo.misses());
+}
+
 TEST(StepMemo, AStepThatFailsIsNotRemembered) {
     auto c = compile(kScene);
     ASSERT_TRUE(c->graph) << c->errors();
