@@ -105,7 +105,7 @@ class Unroller {
         base_ = depth;
         const PathState s{root, pathRule(path, rule), depth, UnrolledInstance::kInherit};
         const Lent lent(out_);
-        finish(build(g_.child(select, rule), s, 0, Affine::identity()));
+        finish(build(g_.child(select, rule), s, 0, nullptr));
     }
 
     // The whole graph from the axiom, in the walk's state at the root (expandTop).
@@ -114,7 +114,7 @@ class Unroller {
         initFrame(g_, root);
         const PathState s{root, kRootPath, 0, UnrolledInstance::kInherit};
         const Lent lent(out_, /*keep=*/false);
-        finish(build(g_.axiom, s, 0, Affine::identity()));
+        finish(build(g_.axiom, s, 0, nullptr));
     }
 
   private:
@@ -194,7 +194,7 @@ class Unroller {
     // Builds what node n holds in state s; returns its index, or kNone when it holds
     // nothing. The inverse matrices in pending_[pendingBase..] and the forward map `edge`
     // lead from the frame of the last operator above (or the S-node) to n's frame.
-    uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+    uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
         if (++visits_ > maxVisits_ && !(cuts_ && visits_ <= cuts_->maxVisits())) throw TooLarge{};
         switch (g_.nodes[n].kind) {
             case NodeKind::Operator:
@@ -219,7 +219,7 @@ class Unroller {
     }
 
     // S, C, T and paint nodes: the one step of semantics.h, as the tracer's walk takes it.
-    uint32_t buildUnary(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+    uint32_t buildUnary(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
         const NodeKind kind = g_.nodes[n].kind;
         StepScratch scratch;
         if (kind == NodeKind::Calc) {
@@ -232,16 +232,19 @@ class Unroller {
             out_.levels_ = std::max(out_.levels_, st.state.depth - base_);
             choices_.push_back(kRuleBit | st.rule);
         }
-        if (st.inverse) pending_.push_back(matrixIndex(*st.inverse));
-        const uint32_t r =
-            build(st.child, st.state, pendingBase, st.forward ? edge * *st.forward : edge);
+        if (st.inverse) pending_.push_back(inverseIndex(n, *st.inverse));
+        // (from the identity: the step's own matrix, not a product with the identity)
+        Affine composed;
+        const Affine* next = edge;
+        if (st.forward) next = edge ? &(composed = *edge * *st.forward) : st.forward;
+        const uint32_t r = build(st.child, st.state, pendingBase, next);
         if (st.inverse) pending_.pop_back();
         if (kind == NodeKind::Select) choices_.pop_back();
         if (kind == NodeKind::Calc) --framesUsed_;
         return r;
     }
 
-    uint32_t buildOperator(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+    uint32_t buildOperator(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
         const ::pcsg::Node& node = g_.nodes[n];
         const CsgOp op = node.op();
         if (cuts_ && op != CsgOp::Union) throw TooLarge{};  // (a top level holds unions only)
@@ -250,8 +253,7 @@ class Unroller {
         const size_t mark = pending_.size();
         for (uint32_t i = 0; i < node.childCount; ++i) {
             choices_.push_back(i);
-            const uint32_t c =
-                build(g_.child(n, i), Semantics::operand(s, i), mark, Affine::identity());
+            const uint32_t c = build(g_.child(n, i), Semantics::operand(s, i), mark, nullptr);
             choices_.pop_back();
             if (c == kNone) {
                 if (!emptyOperandEmptiesAll(op, i)) continue;
@@ -278,7 +280,7 @@ class Unroller {
         return static_cast<uint32_t>(out_.nodes_.size() - 1);
     }
 
-    uint32_t buildPrimitive(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+    uint32_t buildPrimitive(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
         const PrimitiveKind kind = g_.primitives[g_.nodes[n].payload].kind;
         if (kind == PrimitiveKind::Empty) return kNone;
         double args[9] = {};
@@ -296,7 +298,7 @@ class Unroller {
 
     // A cut (expandTop): the expanded instance x of the S-node instance entered in state s.
     uint32_t buildReference(const UnrolledInstance& x, const PathState& s, size_t pendingBase,
-                            const Affine& edge) {
+                            const Affine* edge) {
         if (x.empty()) return kNone;
         Node r = emit(Kind::Instance, s.material, pendingBase, edge, x.box());
         r.first = static_cast<uint32_t>(out_.instances_.size());
@@ -307,7 +309,7 @@ class Unroller {
 
     // A node entered through the matrices pending_[pendingBase..], holding `inside` (in
     // its own frame).
-    Node emit(Kind kind, uint32_t material, size_t pendingBase, const Affine& edge,
+    Node emit(Kind kind, uint32_t material, size_t pendingBase, const Affine* edge,
               const Box& inside) {
         Node x{};
         x.kind = kind;
@@ -316,8 +318,22 @@ class Unroller {
         x.matrices = static_cast<uint32_t>(pending_.size() - pendingBase);
         out_.matrixRefs_.insert(out_.matrixRefs_.end(), pending_.begin() + pendingBase,
                                 pending_.end());
-        x.box = inside.isEmpty() ? Box::empty() : paddedBox(transformBox(edge, inside));
+        x.box = inside.isEmpty() ? Box::empty()
+                                 : paddedBox(edge ? transformBox(*edge, inside) : inside);
         return x;
+    }
+
+    // The index in out_.matrices_ of the inverse matrix of the T-step at n. A constant
+    // T-node's step (a fused chain) always gives the same matrix: its index is looked up
+    // once per expansion (constIndex_, direct-mapped by node) instead of hashed again at
+    // each of the node's steps.
+    uint32_t inverseIndex(NodeId n, const Affine& inverse) {
+        const ::pcsg::Node& node = g_.nodes[n];
+        if (node.kind != NodeKind::Transform || !g_.transforms[node.payload].constant)
+            return matrixIndex(inverse);
+        ConstIndex& c = constIndex_[n % kConstIndexSlots];
+        if (c.node != n) c = {n, matrixIndex(inverse)};
+        return c.index;
     }
 
     // The index of matrix m in out_.matrices_, where each matrix is stored once (the same
@@ -586,6 +602,13 @@ class Unroller {
     size_t framesUsed_ = 0;
     std::vector<uint32_t> pending_;  // matrices (indices in out_.matrices_)
     FlatIndex matrixIndex_;          // by the bits' hash
+    // inverseIndex()'s constant T-nodes met (node kNone: a free slot).
+    static constexpr size_t kConstIndexSlots = 16;
+    struct ConstIndex {
+        NodeId node = kNone;
+        uint32_t index = 0;
+    };
+    ConstIndex constIndex_[kConstIndexSlots];
     std::vector<uint32_t> choices_;
     std::vector<uint32_t> kids_;  // operands of the operators being built
     FlatIndex linkIndex_;         // linkTo()'s links by (parent, matrix)
