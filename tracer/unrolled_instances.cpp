@@ -195,26 +195,39 @@ class Unroller {
     // nothing. The inverse matrices in pending_[pendingBase..] and the forward map `edge`
     // lead from the frame of the last operator above (or the S-node) to n's frame.
     uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
-        if (++visits_ > maxVisits_ && !(cuts_ && visits_ <= cuts_->maxVisits())) throw TooLarge{};
+        if (++visits_ > maxVisits_) pastVisitLimit();
         switch (g_.nodes[n].kind) {
             case NodeKind::Operator:
                 return buildOperator(n, s, pendingBase, edge);
             case NodeKind::Primitive:
                 return buildPrimitive(n, s, pendingBase, edge);
             case NodeKind::Select:
-                try {
-                    if (cuts_) {
-                        const uint32_t depth = sem_.selectDepth(n, s);
-                        if (const UnrolledInstance* x = cuts_->cut(n, s, depth))
-                            return buildReference(*x, s, pendingBase, edge);
-                    }
-                    return buildUnary(n, s, pendingBase, edge);
-                } catch (RuntimeError& e) {
-                    e.enterModule(g_.modules[g_.nodes[n].payload].name);
-                    throw;
-                }
+                return buildSelect(n, s, pendingBase, edge);
             default:
                 return buildUnary(n, s, pendingBase, edge);
+        }
+    }
+
+    // Past maxVisits_: the end of the build, unless a top level's cuts allow more.
+    [[gnu::noinline]] void pastVisitLimit() const {
+        if (!(cuts_ && visits_ <= cuts_->maxVisits())) throw TooLarge{};
+    }
+
+    // An S-node: a cut (expandTop) or its step, and its module on the path of a run-time
+    // error from below. (Out of line: build(), taken at every node, is then only a switch
+    // whose cases jump to their builders, with no frame of its own.)
+    [[gnu::noinline]] uint32_t buildSelect(NodeId n, const PathState& s, size_t pendingBase,
+                                           const Affine* edge) {
+        try {
+            if (cuts_) {
+                const uint32_t depth = sem_.selectDepth(n, s);
+                if (const UnrolledInstance* x = cuts_->cut(n, s, depth))
+                    return buildReference(*x, s, pendingBase, edge);
+            }
+            return buildUnary(n, s, pendingBase, edge);
+        } catch (RuntimeError& e) {
+            e.enterModule(g_.modules[g_.nodes[n].payload].name);
+            throw;
         }
     }
 
