@@ -50,6 +50,8 @@ struct BuildArrays {
     std::vector<double> args;
     std::vector<UnrolledInstance::BvhNode> bvh;
     std::vector<UnrolledInstance::Link> links;
+    // The unroller's indices of the matrices and links (kept, emptied, with their slots).
+    FlatIndex matrixIndex, linkIndex;
     bool lent = false;
 };
 
@@ -63,6 +65,16 @@ constexpr size_t kKeptSlack = 4, kKeptFreely = 64 * 1024;
 BuildArrays& threadArrays() {
     thread_local BuildArrays a;
     return a;
+}
+
+// The thread's index after an expansion: emptied and kept for the next one, unless far
+// larger than the entries this one stored (as giveBack() keeps arrays).
+void giveBack(FlatIndex& index, bool keep) {
+    if (keep && (index.bytes() <= kKeptFreely || index.slots() <= 2 * kKeptSlack * index.size())) {
+        index.clear();
+        return;
+    }
+    index.release();
 }
 
 template <class V>
@@ -104,7 +116,7 @@ class Unroller {
         choices_.push_back(kRuleBit | rule);
         base_ = depth;
         const PathState s{root, pathRule(path, rule), depth, UnrolledInstance::kInherit};
-        const Lent lent(out_);
+        const Lent lent(*this);
         finish(build(g_.child(select, rule), s, 0, nullptr));
     }
 
@@ -113,7 +125,7 @@ class Unroller {
         double* root = pushFrame();
         initFrame(g_, root);
         const PathState s{root, kRootPath, 0, UnrolledInstance::kInherit};
-        const Lent lent(out_, /*keep=*/false);
+        const Lent lent(*this, /*keep=*/false);
         finish(build(g_.axiom, s, 0, nullptr));
     }
 
@@ -133,19 +145,21 @@ class Unroller {
 
     // The thread's BuildArrays lent to the expansion being built (when no other on this
     // thread has them), and taken back when it is done: the expansion's arrays are copied
-    // out at their final sizes, or, should the build throw, given up. Unless `keep`, the
-    // thread's arrays are freed then (a top level: built once, and larger than the
-    // expansions, which would keep its size for good).
+    // out at their final sizes, or, should the build throw, given up; the unroller's
+    // indices are emptied. Unless `keep`, the thread's arrays are freed then (a top level:
+    // built once, and larger than the expansions, which would keep its size for good).
     class Lent {
       public:
-        explicit Lent(UnrolledInstance& x, bool keep = true)
-            : x_(x), b_(threadArrays()), mine_(!b_.lent), keep_(keep) {
+        explicit Lent(Unroller& u, bool keep = true)
+            : u_(u), x_(u.out_), b_(threadArrays()), mine_(!b_.lent), keep_(keep) {
             if (!mine_) return;
             b_.lent = true;
             eachArray(b_, x_, [](auto& b, auto& x) {
                 b.clear();
                 x.swap(b);
             });
+            std::swap(u_.matrixIndex_, b_.matrixIndex);
+            std::swap(u_.linkIndex_, b_.linkIndex);
         }
         ~Lent() {
             if (!mine_) {
@@ -158,12 +172,17 @@ class Unroller {
                 if (done) x.assign(b.begin(), b.end());
                 giveBack(b, b.size(), keep);
             });
+            std::swap(u_.matrixIndex_, b_.matrixIndex);
+            std::swap(u_.linkIndex_, b_.linkIndex);
+            giveBack(b_.matrixIndex, keep_);
+            giveBack(b_.linkIndex, keep_);
             b_.lent = false;
         }
         Lent(const Lent&) = delete;
         Lent& operator=(const Lent&) = delete;
 
       private:
+        Unroller& u_;
         UnrolledInstance& x_;
         BuildArrays& b_;
         const bool mine_, keep_;
@@ -946,7 +965,7 @@ size_t UnrolledInstance::keptBuildBytes() {
     };
     add(b.nodes), add(b.children), add(b.matrixRefs), add(b.choices);
     add(b.matrices), add(b.args), add(b.bvh), add(b.links);
-    return bytes;
+    return bytes + b.matrixIndex.bytes() + b.linkIndex.bytes();
 }
 
 std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts) {
