@@ -6,10 +6,13 @@
 // triangles some 600 of them per expansion and 17,500 expansions per 640x480 frame, which
 // with the expansions' growing and freed arrays kept glibc's allocator busy (malloc and
 // free, and malloc_consolidate on each large free: about 8% of the terrain's CPU samples).
-// Here the entries live in one power-of-two array with linear probing; it grows by
-// doubling (a handful of allocations per expansion) and is never shrunk. What it answers
-// is what the unordered_map answered: the value stored first under a key, so the indices
-// an expansion gets, and so its arrays, are the same.
+// Here the entries live in one power-of-two array with linear probing, at most half full;
+// it grows by doubling and is never shrunk. A thread keeps its indices from one expansion
+// to the next: clear() empties one by a new stamp (a slot is used when it holds the
+// current one), so that an expansion neither grows nor rehashes the table again, nor
+// writes its slots to empty it. What it answers is what the unordered_map answered: the
+// value stored first under a key, so the indices an expansion gets, and so its arrays,
+// are the same.
 #pragma once
 
 #include <cstddef>
@@ -24,12 +27,12 @@ class FlatIndex {
     // The value stored under `key`, or, when there is none, `value` stored under it:
     // {that value, whether it was stored now} (as std::unordered_map::try_emplace).
     std::pair<uint32_t, bool> tryEmplace(uint64_t key, uint32_t value) {
-        if ((count_ + 1) * 4 > slots_.size() * 3) grow();
+        if ((count_ + 1) * 2 > slots_.size()) grow();
         const size_t mask = slots_.size() - 1;
         for (size_t i = home(key, mask);; i = (i + 1) & mask) {
             Slot& s = slots_[i];
-            if (!s.used) {
-                s = {key, value, 1};
+            if (s.stamp != stamp_) {
+                s = {key, value, stamp_};
                 ++count_;
                 return {value, true};
             }
@@ -38,12 +41,27 @@ class FlatIndex {
     }
 
     size_t size() const { return count_; }
+    size_t slots() const { return slots_.size(); }
+    size_t bytes() const { return slots_.capacity() * sizeof(Slot); }
+
+    // Empties the index, keeping its slots.
+    void clear() {
+        count_ = 0;
+        if (++stamp_ != 0) return;
+        for (Slot& s : slots_) s.stamp = 0;  // (the stamps wrapped: all slots empty again)
+        stamp_ = 1;
+    }
+    // Empties the index and frees its slots.
+    void release() {
+        std::vector<Slot>().swap(slots_);
+        count_ = 0;
+    }
 
   private:
     struct Slot {
         uint64_t key = 0;
         uint32_t value = 0;
-        uint32_t used = 0;
+        uint32_t stamp = 0;  // used when stamp_
     };
 
     // Fibonacci hashing: keys may be (parent << 32 | matrix) pairs, whose low bits alone
@@ -57,15 +75,16 @@ class FlatIndex {
         slots_.assign(old.empty() ? 64 : old.size() * 2, Slot{});
         const size_t mask = slots_.size() - 1;
         for (const Slot& o : old) {
-            if (!o.used) continue;
+            if (o.stamp != stamp_) continue;
             size_t i = home(o.key, mask);
-            while (slots_[i].used) i = (i + 1) & mask;
+            while (slots_[i].stamp == stamp_) i = (i + 1) & mask;
             slots_[i] = o;
         }
     }
 
     std::vector<Slot> slots_;  // size 0 or a power of two
     size_t count_ = 0;
+    uint32_t stamp_ = 1;  // never 0, the stamp of a slot never used
 };
 
 }  // namespace pcsg::tracer

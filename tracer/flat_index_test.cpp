@@ -49,5 +49,29 @@ TEST(FlatIndex, AnswersAsAnUnorderedMapThroughItsGrowth) {
     EXPECT_EQ(index.size(), reference.size());
 }
 
+// clear() empties the index for the next expansion and keeps its slots: the keys stored
+// before are gone (stored anew, with the new values), the table is not grown again, and
+// release() frees it.
+TEST(FlatIndex, ClearedItForgetsEveryKeyAndKeepsItsSlots) {
+    FlatIndex index;
+    for (uint32_t round = 0; round < 3; ++round) {
+        for (uint32_t k = 0; k < 1000; ++k) {
+            const uint64_t key = (static_cast<uint64_t>(k % 37) << 32) | k;
+            ASSERT_EQ(index.tryEmplace(key, k + round), std::make_pair(k + round, true))
+                << "round " << round << " key " << k;
+            ASSERT_EQ(index.tryEmplace(key, 7), std::make_pair(k + round, false));
+        }
+        EXPECT_EQ(index.size(), 1000u);
+        const size_t slots = index.slots();
+        EXPECT_GE(slots, 2000u);  // (at most half full)
+        index.clear();
+        EXPECT_EQ(index.size(), 0u);
+        EXPECT_EQ(index.slots(), slots);
+    }
+    index.release();
+    EXPECT_EQ(index.slots(), 0u);
+    EXPECT_EQ(index.tryEmplace(5, 1), std::make_pair(1u, true));
+}
+
 }  // namespace
 }  // namespace pcsg::tracer

@@ -50,6 +50,8 @@ struct BuildArrays {
     std::vector<double> args;
     std::vector<UnrolledInstance::BvhNode> bvh;
     std::vector<UnrolledInstance::Link> links;
+    // The unroller's indices of the matrices and links (kept, emptied, with their slots).
+    FlatIndex matrixIndex, linkIndex;
     bool lent = false;
 };
 
@@ -63,6 +65,16 @@ constexpr size_t kKeptSlack = 4, kKeptFreely = 64 * 1024;
 BuildArrays& threadArrays() {
     thread_local BuildArrays a;
     return a;
+}
+
+// The thread's index after an expansion: emptied and kept for the next one, unless far
+// larger than the entries this one stored (as giveBack() keeps arrays).
+void giveBack(FlatIndex& index, bool keep) {
+    if (keep && (index.bytes() <= kKeptFreely || index.slots() <= 2 * kKeptSlack * index.size())) {
+        index.clear();
+        return;
+    }
+    index.release();
 }
 
 template <class V>
@@ -104,8 +116,8 @@ class Unroller {
         choices_.push_back(kRuleBit | rule);
         base_ = depth;
         const PathState s{root, pathRule(path, rule), depth, UnrolledInstance::kInherit};
-        const Lent lent(out_);
-        finish(build(g_.child(select, rule), s, 0, Affine::identity()));
+        const Lent lent(*this);
+        finish(build(g_.child(select, rule), s, 0, nullptr));
     }
 
     // The whole graph from the axiom, in the walk's state at the root (expandTop).
@@ -113,8 +125,8 @@ class Unroller {
         double* root = pushFrame();
         initFrame(g_, root);
         const PathState s{root, kRootPath, 0, UnrolledInstance::kInherit};
-        const Lent lent(out_, /*keep=*/false);
-        finish(build(g_.axiom, s, 0, Affine::identity()));
+        const Lent lent(*this, /*keep=*/false);
+        finish(build(g_.axiom, s, 0, nullptr));
     }
 
   private:
@@ -133,19 +145,21 @@ class Unroller {
 
     // The thread's BuildArrays lent to the expansion being built (when no other on this
     // thread has them), and taken back when it is done: the expansion's arrays are copied
-    // out at their final sizes, or, should the build throw, given up. Unless `keep`, the
-    // thread's arrays are freed then (a top level: built once, and larger than the
-    // expansions, which would keep its size for good).
+    // out at their final sizes, or, should the build throw, given up; the unroller's
+    // indices are emptied. Unless `keep`, the thread's arrays are freed then (a top level:
+    // built once, and larger than the expansions, which would keep its size for good).
     class Lent {
       public:
-        explicit Lent(UnrolledInstance& x, bool keep = true)
-            : x_(x), b_(threadArrays()), mine_(!b_.lent), keep_(keep) {
+        explicit Lent(Unroller& u, bool keep = true)
+            : u_(u), x_(u.out_), b_(threadArrays()), mine_(!b_.lent), keep_(keep) {
             if (!mine_) return;
             b_.lent = true;
             eachArray(b_, x_, [](auto& b, auto& x) {
                 b.clear();
                 x.swap(b);
             });
+            std::swap(u_.matrixIndex_, b_.matrixIndex);
+            std::swap(u_.linkIndex_, b_.linkIndex);
         }
         ~Lent() {
             if (!mine_) {
@@ -158,12 +172,17 @@ class Unroller {
                 if (done) x.assign(b.begin(), b.end());
                 giveBack(b, b.size(), keep);
             });
+            std::swap(u_.matrixIndex_, b_.matrixIndex);
+            std::swap(u_.linkIndex_, b_.linkIndex);
+            giveBack(b_.matrixIndex, keep_);
+            giveBack(b_.linkIndex, keep_);
             b_.lent = false;
         }
         Lent(const Lent&) = delete;
         Lent& operator=(const Lent&) = delete;
 
       private:
+        Unroller& u_;
         UnrolledInstance& x_;
         BuildArrays& b_;
         const bool mine_, keep_;
@@ -194,32 +213,45 @@ class Unroller {
     // Builds what node n holds in state s; returns its index, or kNone when it holds
     // nothing. The inverse matrices in pending_[pendingBase..] and the forward map `edge`
     // lead from the frame of the last operator above (or the S-node) to n's frame.
-    uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
-        if (++visits_ > maxVisits_ && !(cuts_ && visits_ <= cuts_->maxVisits())) throw TooLarge{};
+    uint32_t build(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
+        if (++visits_ > maxVisits_) pastVisitLimit();
         switch (g_.nodes[n].kind) {
             case NodeKind::Operator:
                 return buildOperator(n, s, pendingBase, edge);
             case NodeKind::Primitive:
                 return buildPrimitive(n, s, pendingBase, edge);
             case NodeKind::Select:
-                try {
-                    if (cuts_) {
-                        const uint32_t depth = sem_.selectDepth(n, s);
-                        if (const UnrolledInstance* x = cuts_->cut(n, s, depth))
-                            return buildReference(*x, s, pendingBase, edge);
-                    }
-                    return buildUnary(n, s, pendingBase, edge);
-                } catch (RuntimeError& e) {
-                    e.enterModule(g_.modules[g_.nodes[n].payload].name);
-                    throw;
-                }
+                return buildSelect(n, s, pendingBase, edge);
             default:
                 return buildUnary(n, s, pendingBase, edge);
         }
     }
 
+    // Past maxVisits_: the end of the build, unless a top level's cuts allow more.
+    [[gnu::noinline]] void pastVisitLimit() const {
+        if (!(cuts_ && visits_ <= cuts_->maxVisits())) throw TooLarge{};
+    }
+
+    // An S-node: a cut (expandTop) or its step, and its module on the path of a run-time
+    // error from below. (Out of line: build(), taken at every node, is then only a switch
+    // whose cases jump to their builders, with no frame of its own.)
+    [[gnu::noinline]] uint32_t buildSelect(NodeId n, const PathState& s, size_t pendingBase,
+                                           const Affine* edge) {
+        try {
+            if (cuts_) {
+                const uint32_t depth = sem_.selectDepth(n, s);
+                if (const UnrolledInstance* x = cuts_->cut(n, s, depth))
+                    return buildReference(*x, s, pendingBase, edge);
+            }
+            return buildUnary(n, s, pendingBase, edge);
+        } catch (RuntimeError& e) {
+            e.enterModule(g_.modules[g_.nodes[n].payload].name);
+            throw;
+        }
+    }
+
     // S, C, T and paint nodes: the one step of semantics.h, as the tracer's walk takes it.
-    uint32_t buildUnary(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+    uint32_t buildUnary(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
         const NodeKind kind = g_.nodes[n].kind;
         StepScratch scratch;
         if (kind == NodeKind::Calc) {
@@ -232,16 +264,19 @@ class Unroller {
             out_.levels_ = std::max(out_.levels_, st.state.depth - base_);
             choices_.push_back(kRuleBit | st.rule);
         }
-        if (st.inverse) pending_.push_back(matrixIndex(*st.inverse));
-        const uint32_t r =
-            build(st.child, st.state, pendingBase, st.forward ? edge * *st.forward : edge);
+        if (st.inverse) pending_.push_back(inverseIndex(n, *st.inverse));
+        // (from the identity: the step's own matrix, not a product with the identity)
+        Affine composed;
+        const Affine* next = edge;
+        if (st.forward) next = edge ? &(composed = *edge * *st.forward) : st.forward;
+        const uint32_t r = build(st.child, st.state, pendingBase, next);
         if (st.inverse) pending_.pop_back();
         if (kind == NodeKind::Select) choices_.pop_back();
         if (kind == NodeKind::Calc) --framesUsed_;
         return r;
     }
 
-    uint32_t buildOperator(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+    uint32_t buildOperator(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
         const ::pcsg::Node& node = g_.nodes[n];
         const CsgOp op = node.op();
         if (cuts_ && op != CsgOp::Union) throw TooLarge{};  // (a top level holds unions only)
@@ -250,8 +285,7 @@ class Unroller {
         const size_t mark = pending_.size();
         for (uint32_t i = 0; i < node.childCount; ++i) {
             choices_.push_back(i);
-            const uint32_t c =
-                build(g_.child(n, i), Semantics::operand(s, i), mark, Affine::identity());
+            const uint32_t c = build(g_.child(n, i), Semantics::operand(s, i), mark, nullptr);
             choices_.pop_back();
             if (c == kNone) {
                 if (!emptyOperandEmptiesAll(op, i)) continue;
@@ -278,7 +312,7 @@ class Unroller {
         return static_cast<uint32_t>(out_.nodes_.size() - 1);
     }
 
-    uint32_t buildPrimitive(NodeId n, const PathState& s, size_t pendingBase, const Affine& edge) {
+    uint32_t buildPrimitive(NodeId n, const PathState& s, size_t pendingBase, const Affine* edge) {
         const PrimitiveKind kind = g_.primitives[g_.nodes[n].payload].kind;
         if (kind == PrimitiveKind::Empty) return kNone;
         double args[9] = {};
@@ -296,7 +330,7 @@ class Unroller {
 
     // A cut (expandTop): the expanded instance x of the S-node instance entered in state s.
     uint32_t buildReference(const UnrolledInstance& x, const PathState& s, size_t pendingBase,
-                            const Affine& edge) {
+                            const Affine* edge) {
         if (x.empty()) return kNone;
         Node r = emit(Kind::Instance, s.material, pendingBase, edge, x.box());
         r.first = static_cast<uint32_t>(out_.instances_.size());
@@ -307,7 +341,7 @@ class Unroller {
 
     // A node entered through the matrices pending_[pendingBase..], holding `inside` (in
     // its own frame).
-    Node emit(Kind kind, uint32_t material, size_t pendingBase, const Affine& edge,
+    Node emit(Kind kind, uint32_t material, size_t pendingBase, const Affine* edge,
               const Box& inside) {
         Node x{};
         x.kind = kind;
@@ -316,8 +350,22 @@ class Unroller {
         x.matrices = static_cast<uint32_t>(pending_.size() - pendingBase);
         out_.matrixRefs_.insert(out_.matrixRefs_.end(), pending_.begin() + pendingBase,
                                 pending_.end());
-        x.box = inside.isEmpty() ? Box::empty() : paddedBox(transformBox(edge, inside));
+        x.box = inside.isEmpty() ? Box::empty()
+                                 : paddedBox(edge ? transformBox(*edge, inside) : inside);
         return x;
+    }
+
+    // The index in out_.matrices_ of the inverse matrix of the T-step at n. A constant
+    // T-node's step (a fused chain) always gives the same matrix: its index is looked up
+    // once per expansion (constIndex_, direct-mapped by node) instead of hashed again at
+    // each of the node's steps.
+    uint32_t inverseIndex(NodeId n, const Affine& inverse) {
+        const ::pcsg::Node& node = g_.nodes[n];
+        if (node.kind != NodeKind::Transform || !g_.transforms[node.payload].constant)
+            return matrixIndex(inverse);
+        ConstIndex& c = constIndex_[n % kConstIndexSlots];
+        if (c.node != n) c = {n, matrixIndex(inverse)};
+        return c.index;
     }
 
     // The index of matrix m in out_.matrices_, where each matrix is stored once (the same
@@ -586,6 +634,13 @@ class Unroller {
     size_t framesUsed_ = 0;
     std::vector<uint32_t> pending_;  // matrices (indices in out_.matrices_)
     FlatIndex matrixIndex_;          // by the bits' hash
+    // inverseIndex()'s constant T-nodes met (node kNone: a free slot).
+    static constexpr size_t kConstIndexSlots = 16;
+    struct ConstIndex {
+        NodeId node = kNone;
+        uint32_t index = 0;
+    };
+    ConstIndex constIndex_[kConstIndexSlots];
     std::vector<uint32_t> choices_;
     std::vector<uint32_t> kids_;  // operands of the operators being built
     FlatIndex linkIndex_;         // linkTo()'s links by (parent, matrix)
@@ -910,7 +965,7 @@ size_t UnrolledInstance::keptBuildBytes() {
     };
     add(b.nodes), add(b.children), add(b.matrixRefs), add(b.choices);
     add(b.matrices), add(b.args), add(b.bvh), add(b.links);
-    return bytes;
+    return bytes + b.matrixIndex.bytes() + b.linkIndex.bytes();
 }
 
 std::unique_ptr<UnrolledInstance> UnrolledInstance::expandTop(const TraceScene& scene, Cuts& cuts) {

@@ -177,6 +177,37 @@ TEST(ExpandedInstances, FourWideHierarchiesWithEmptySlotsHitTheSameSurfaces) {
     EXPECT_GT(compareWithGraphWalk(kThrees, 0.6, 20), 0u);
 }
 
+// Eighteen constant chains of matrices under one rule, each met at every level of the
+// recursion (the unroller looks a constant T-node's inverse up once per expansion, in a
+// table by node with fewer slots than there are nodes: each must keep its own matrix).
+const char* kManyConstants = R"(
+{n = 2} T
+T if(n > 0, 2, 1)
+1: T -> sphere ∪ move(0,0,0.6) uscale(0.5) cube
+2: T -> {n = n-1} (move(-1.25,0,-0.6) uscale(0.12) rotz(0) T ∪
+    move(-0.75,0,-0.6) uscale(0.124) rotz(5) T ∪
+    move(-0.25,0,-0.6) uscale(0.128) rotz(10) T ∪
+    move(0.25,0,-0.6) uscale(0.132) rotz(15) T ∪
+    move(0.75,0,-0.6) uscale(0.136) rotz(20) T ∪
+    move(1.25,0,-0.6) uscale(0.14) rotz(25) T ∪
+    move(-1.25,0,0.0) uscale(0.144) rotz(30) T ∪
+    move(-0.75,0,0.0) uscale(0.148) rotz(35) T ∪
+    move(-0.25,0,0.0) uscale(0.152) rotz(40) T ∪
+    move(0.25,0,0.0) uscale(0.156) rotz(45) T ∪
+    move(0.75,0,0.0) uscale(0.16) rotz(50) T ∪
+    move(1.25,0,0.0) uscale(0.164) rotz(55) T ∪
+    move(-1.25,0,0.6) uscale(0.168) rotz(60) T ∪
+    move(-0.75,0,0.6) uscale(0.172) rotz(65) T ∪
+    move(-0.25,0,0.6) uscale(0.176) rotz(70) T ∪
+    move(0.25,0,0.6) uscale(0.18) rotz(75) T ∪
+    move(0.75,0,0.6) uscale(0.184) rotz(80) T ∪
+    move(1.25,0,0.6) uscale(0.188) rotz(85) T)
+)";
+
+TEST(ExpandedInstances, ManyConstantMatricesEachKeepTheirOwn) {
+    EXPECT_GT(compareWithGraphWalk(kManyConstants, 1.5, 200), 0u);
+}
+
 TEST(ExpandedInstances, BoxesRoundOutwardsToFloats) {
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> mantissa(1, 2);
