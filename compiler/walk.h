@@ -35,6 +35,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -54,6 +55,7 @@ struct WalkEntry {
     size_t resultBase;  // size of the result stack when an operator began
     uint64_t path;      // the instance path
     Affine world;       // maps this node's frame to the start node's frame
+    bool identity;      // world is Affine::identity() as the walk set it (no T-step since)
     size_t mark[4];     // the sink's bookkeeping for operators
 };
 
@@ -90,7 +92,9 @@ class Walker {
         stack_.clear();
         results_.clear();
         if (start.node == kNone || start.node >= g_.nodes.size()) return sink_.nothing();
-        arena_.assign(frameSize_, 0.0);
+        if (arena_.size() < frameSize_) arena_.resize(frameSize_);
+        arenaTop_ = frameSize_;
+        std::fill_n(arena_.begin(), frameSize_, 0.0);
         if (start.frame)
             std::copy(start.frame, start.frame + g_.slotCount(), arena_.begin());
         else
@@ -101,6 +105,7 @@ class Walker {
         root.material = start.material;
         root.path = start.path;
         root.world = Affine::identity();
+        root.identity = true;
         stack_.push_back(root);
         try {
             while (!stack_.empty()) step();
@@ -168,22 +173,59 @@ class Walker {
         scratch.forwardOnly = true;  // (world matrices only: no T-node's inverse is read)
         size_t frame = e.frame;
         if (kind == NodeKind::Calc) {
-            frame = arena_.size();
-            arena_.resize(frame + frameSize_);
+            frame = pushFrame();
             scratch.frame = arena_.data() + frame;
         }
         const Step st = sem_.enter(e.node, stateOf(e), scratch);
         e.next = 1;
-        WalkEntry c = e;
+        const NodeId n = e.node;
+        // The child starts as a copy of e (made in place: e's entry is large), then changes.
+        stack_.push_back(e);  // (e may move: only the copy is used below)
+        WalkEntry& c = stack_.back();
         c.node = st.child;
         c.next = 0;
         c.frame = frame;
         c.path = st.state.path;
         c.depth = st.state.depth;
         c.material = st.state.material;
-        if (st.forward) c.world = sem_.forwardThrough(e.world, e.node, st);
-        if (kind == NodeKind::Select && localSelectFrames()) c.world = Affine::identity();
-        stack_.push_back(c);
+        if (st.forward) {
+            c.world = c.identity ? fromIdentity(n, st) : sem_.forwardThrough(c.world, n, st);
+            c.identity = false;
+        }
+        if (kind == NodeKind::Select && localSelectFrames()) {
+            c.world = Affine::identity();
+            c.identity = true;
+        }
+    }
+
+    // forwardThrough(identity, n, st) without its products where they give the step's own
+    // matrix bit for bit (below every S-node of a sink with local frames, the first T-step
+    // is such a product): a fused chain's matrix is that product (Semantics multiplies it
+    // out from the identity the same way); identity * M is M where M holds no -0 (+0 + -0
+    // is +0) and no infinity or NaN (0 * inf is NaN), else it is multiplied.
+    Affine fromIdentity(NodeId n, const Step& st) const {
+        if (sem_.nodesInStep(n) > 1 || identityTimesIsExact(*st.forward)) return *st.forward;
+        return sem_.forwardThrough(Affine::identity(), n, st);
+    }
+    static bool identityTimesIsExact(const Affine& m) {
+        constexpr uint64_t kMinusZero = uint64_t{1} << 63, kExponent = uint64_t{0x7ff} << 52;
+        bool exact = true;
+        auto check = [&](double x) {
+            const uint64_t b = std::bit_cast<uint64_t>(x);
+            exact = exact && b != kMinusZero && (b & kExponent) != kExponent;
+        };
+        for (const auto& row : m.l)
+            for (double x : row) check(x);
+        check(m.t.x), check(m.t.y), check(m.t.z);
+        return exact;
+    }
+
+    // A C-node's new frame on the arena (not cleared: the C-step writes all of it); its offset.
+    size_t pushFrame() {
+        const size_t frame = arenaTop_;
+        arenaTop_ += frameSize_;
+        if (arenaTop_ > arena_.size()) arena_.resize(std::max(arenaTop_, 2 * arena_.size()));
+        return frame;
     }
 
     // ... and on the way back up.
@@ -198,7 +240,7 @@ class Walker {
                 sink_.paint(g_.nodes[e.node].payload, e.world, results_.back());
         }
         // Frames are released in stack order: the C-node's child's is the last one.
-        if (kind == NodeKind::Calc) arena_.resize(arena_.size() - frameSize_);
+        if (kind == NodeKind::Calc) arenaTop_ -= frameSize_;
         stack_.pop_back();
     }
 
@@ -211,11 +253,13 @@ class Walker {
         }
         if (e.next < node.childCount) {
             const uint32_t i = e.next++;
-            WalkEntry c = e;
-            c.node = g_.child(e.node, i);
+            const NodeId child = g_.child(e.node, i);
+            const uint64_t path = Semantics::operand(stateOf(e), i).path;
+            stack_.push_back(e);  // (in place, as in enterUnary)
+            WalkEntry& c = stack_.back();
+            c.node = child;
             c.next = 0;
-            c.path = Semantics::operand(stateOf(e), i).path;
-            stack_.push_back(c);
+            c.path = path;
             return;
         }
         const size_t base = e.resultBase;
@@ -240,7 +284,8 @@ class Walker {
     Sink& sink_;
     const size_t frameSize_;
     std::vector<WalkEntry> stack_;
-    std::vector<double> arena_;
+    std::vector<double> arena_;  // the frames: [0, arenaTop_) in use
+    size_t arenaTop_ = 0;
     std::vector<Result> results_;
 };
 

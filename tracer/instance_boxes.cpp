@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "key_slots.h"
+#include "outward_float.h"
 #include "primitives.h"
 #include "thread_pool.h"
 
@@ -28,18 +29,6 @@ inline uint64_t mix(uint64_t z) {
     return z ^ (z >> 31);
 }
 
-// A double rounded to a float towards -inf or +inf (the stored boxes only ever grow).
-inline float down(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-    return f;
-}
-inline float up(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
-}
-
 // A box as the table stores it (floats, rounded outwards). Every instance box is rounded
 // so, stored or not, so that a box built from inner boxes is the same number whether
 // they came from the table or were computed again.
@@ -47,8 +36,8 @@ inline Box storable(const Box& b) {
     if (b.isEmpty()) return Box::empty();
     Box r;
     for (int j = 0; j < 3; ++j) {
-        r.lo[j] = down(b.lo[j]);
-        r.hi[j] = up(b.hi[j]);
+        r.lo[j] = castDown(b.lo[j]);
+        r.hi[j] = castUp(b.hi[j]);
     }
     return r;
 }
@@ -366,34 +355,22 @@ void InstanceBoxes::WorkerDeleter::operator()(Worker* w) const {
     delete w;
 }
 
-bool InstanceBoxes::useAt(NodeId select, uint32_t depth) const {
-    if (depth >= levels_) return false;
-    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
-    return decision_[i].load(std::memory_order_relaxed) != 2;
-}
-
 bool InstanceBoxes::mayHold(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return true;
-    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    const size_t i = levelIndex(select, depth);
     return stored_[i].load(std::memory_order_relaxed) != 0;
 }
 
 void InstanceBoxes::held(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return;
-    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    const size_t i = levelIndex(select, depth);
     if (stored_[i].load(std::memory_order_relaxed) == 0)
         stored_[i].store(1, std::memory_order_relaxed);
 }
 
-bool InstanceBoxes::unrollAt(NodeId select, uint32_t depth) const {
-    if (depth >= levels_) return false;
-    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
-    return expand_[i].load(std::memory_order_relaxed) != 0;
-}
-
 uint64_t InstanceBoxes::unrollWeight(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return 0;
-    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    const size_t i = levelIndex(select, depth);
     return maxWeight_[i].load(std::memory_order_relaxed);
 }
 
@@ -436,7 +413,7 @@ void InstanceBoxes::insert(NodeId select, const Key& k, const Stored& s) const {
 
 // The trial of exact boxes at (module, depth): do they pay?
 void InstanceBoxes::record(NodeId select, uint32_t depth, const Stored& s) const {
-    const size_t i = static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    const size_t i = levelIndex(select, depth);
     if (decision_[i].load(std::memory_order_relaxed) != 0) return;
     bool pays = false;
     if (s.weight >= opt_.minWeight) {

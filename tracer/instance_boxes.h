@@ -94,11 +94,18 @@ class InstanceBoxes {
     InstanceBoxes(const InstanceBoxes&) = delete;
     InstanceBoxes& operator=(const InstanceBoxes&) = delete;
 
-    // Whether exact boxes are used for this S-node at this depth (see above).
-    bool useAt(NodeId select, uint32_t depth) const;
+    // Whether exact boxes are used for this S-node at this depth (see above). (Inline, as
+    // unrollAt: the walk asks at every S-node of every ray.)
+    bool useAt(NodeId select, uint32_t depth) const {
+        return depth < levels_ &&
+               decision_[levelIndex(select, depth)].load(std::memory_order_relaxed) != 2;
+    }
     // Whether the instances of this S-node at this depth are worth expanding: decided
     // with useAt, from the sizes of the first instances met there.
-    bool unrollAt(NodeId select, uint32_t depth) const;
+    bool unrollAt(NodeId select, uint32_t depth) const {
+        return depth < levels_ &&
+               expand_[levelIndex(select, depth)].load(std::memory_order_relaxed) != 0;
+    }
     uint64_t maxUnrollWeight() const { return opt_.maxUnrollWeight; }
     // The visits the heaviest instance of this S-node at this depth took to unroll, of
     // those met so far (0: none), for the expansion cache's estimate of their bytes.
@@ -173,6 +180,10 @@ class InstanceBoxes {
     bool mayHold(NodeId select, uint32_t depth) const;
     void held(NodeId select, uint32_t depth) const;
     void record(NodeId select, uint32_t depth, const Stored& s) const;
+    // The index of (module, depth < levels_) in the per-level arrays below.
+    size_t levelIndex(NodeId select, uint32_t depth) const {
+        return static_cast<size_t>(g_.nodes[select].payload) * levels_ + depth;
+    }
 
     const Graph& g_;
     Semantics sem_;

@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <random>
 
 #include "expander.h"
+#include "outward_float.h"
 #include "primitives.h"
 #include "test_support.h"
 #include "traversal.h"
@@ -487,6 +489,29 @@ TEST(InstanceBoxes, CullingWithThemNeverChangesAHit) {
         }
         EXPECT_GT(hits, 50);
         EXPECT_LT(te.nodeVisits(), tn.nodeVisits());
+    }
+}
+
+// The boxes' rounding to floats (castDown, castUp: the cast, stepped without libm) gives the
+// bits of the cast stepped by std::nextafter, the rounding the table's boxes had before:
+// zeros, subnormals, the largest floats and infinities included.
+TEST(InstanceBoxes, BoxesRoundToTheFloatsNextafterGives) {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> mantissa(1, 2);
+    std::uniform_int_distribution<int> exponent(-160, 160);
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> xs = {0.0,           -0.0,         1.0,           0.1,    -0.1,
+                              1e-45,         -1e-45,       1e-50,         -1e-50, 3.4028234e38,
+                              -3.4028234e38, 3.4028236e38, -3.4028236e38, 3.5e38, -3.5e38,
+                              1e300,         -1e300,       inf,           -inf};
+    for (int i = 0; i < 4000; ++i)
+        xs.push_back((i % 2 ? -1 : 1) * std::ldexp(mantissa(rng), exponent(rng)));
+    for (double x : xs) {
+        const float f = static_cast<float>(x);
+        const float down = static_cast<double>(f) > x ? std::nextafter(f, -INFINITY) : f;
+        const float up = static_cast<double>(f) < x ? std::nextafter(f, INFINITY) : f;
+        EXPECT_EQ(std::bit_cast<uint32_t>(castDown(x)), std::bit_cast<uint32_t>(down)) << x;
+        EXPECT_EQ(std::bit_cast<uint32_t>(castUp(x)), std::bit_cast<uint32_t>(up)) << x;
     }
 }
 

@@ -35,4 +35,17 @@ inline float floatAbove(double x) {
     return -floatBelow(-x);
 }
 
+// x cast to float, then stepped down (up) once if the cast went above (below) x: the bits
+// std::nextafter(static_cast<float>(x), -inf) (+inf) gives there, without the call into
+// libm. Unlike floatBelow, an infinite x stays infinite (the instance boxes' rounding,
+// instance_boxes.cpp, which rounds every S-node instance's box so).
+inline float castDown(double x) {
+    const float f = static_cast<float>(x);
+    return static_cast<double>(f) > x ? floatStepDown(f) : f;
+}
+inline float castUp(double x) {
+    const float f = static_cast<float>(x);
+    return static_cast<double>(f) < x ? -floatStepDown(-f) : f;
+}
+
 }  // namespace pcsg::tracer

@@ -233,13 +233,15 @@ const TopLevel* Tracer::topLevel() {
     return scene_.buildTopLevel();
 }
 
-// The unrolled instance to trace instead of walking below S-node n, if there is one.
+// The unrolled instance to trace instead of walking below S-node n, if there is one: after
+// builtAt, which found it not built, its meeting (a note or an expansion; meet() finds an
+// instance built meanwhile too, as get() would).
 const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t depth,
                                            std::optional<InstanceBoxes::Key>& key) {
     if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->unrollAt(n, depth))
         return nullptr;
     if (!key) key = scene_.instanceBoxes_->keyOf(n, c.frame, c.path);
-    const UnrolledInstance* x = expansion_->get(*key, n, depth, c.frame, c.path);
+    const UnrolledInstance* x = expansion_->meet(*key, n, depth, c.frame, c.path);
     // Used only where its deepest S-node stays within max_depth (else the walk reports it).
     if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
     if (x && anyHit_) occluder_.entering(n, depth, *key);

@@ -83,6 +83,7 @@ UnrollCache::UnrollCache(const TraceScene& scene, size_t maxBytes, size_t startB
       budget_(startBytes_),
       levels_(scene.graph().scene.settings.maxDepth + 2),
       shards_(std::make_unique<Shard[]>(kShards)),
+      builtFilter_(std::make_unique<std::atomic<uint32_t>[]>(kFilterSlots)),
       yield_(std::make_unique<Yield[]>(scene.graph().modules.size() * levels_)) {}
 
 UnrollCache::~UnrollCache() = default;
@@ -196,6 +197,7 @@ void UnrollCache::evict() {
                 continue;
             }
             if (e.instance) {  // leaves a ghost behind (a later expansion is a rebuild)
+                filterAdd(k, -1);
                 freed += e.bytes;
                 out.push_back(std::move(e.instance));
                 bytes_.fetch_sub(e.bytes, std::memory_order_relaxed);
@@ -259,7 +261,7 @@ const UnrolledInstance* UnrollCache::Reader::built(const InstanceBoxes::Key& key
                                                    uint32_t depth) {
     if (depth >= cache_.levels_ || cache_.entries() == 0) return nullptr;
     const size_t y = cache_.yieldIndex(select, depth);
-    if (cache_.yield_[y].skipped(cache_.budget())) return nullptr;
+    if (cache_.yield_[y].skipped(cache_.budget()) || !cache_.mayBeBuilt(key)) return nullptr;
     Shard& s = cache_.shardOf(key);
     pinOnce();
     tbb::spin_rw_mutex::scoped_lock lock(s.mutex, /*write=*/false);
@@ -290,6 +292,12 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
                                                  uint32_t depth, const double* frame,
                                                  uint64_t path) {
     if (const UnrolledInstance* x = built(key, select, depth)) return x;
+    return meet(key, select, depth, frame, path);
+}
+
+const UnrolledInstance* UnrollCache::Reader::meet(const InstanceBoxes::Key& key, NodeId select,
+                                                  uint32_t depth, const double* frame,
+                                                  uint64_t path) {
     if (depth >= cache_.levels_) return nullptr;
     const size_t y = cache_.yieldIndex(select, depth);
     if (cache_.yield_[y].skipped(cache_.budget())) {
@@ -327,14 +335,15 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
         if (cache_.bytes() > cache_.budget()) cache_.evict();
         return nullptr;
     }
-    return expand(s, *e, y, select, depth, frame, path);
+    return expand(s, *e, key, y, select, depth, frame, path);
 }
 
 // Expands the instance of entry e (in construction, so that it stays in its shard while
 // no lock is held).
-const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e, size_t y, NodeId select,
-                                                    uint32_t depth, const double* frame,
-                                                    uint64_t path) {
+const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e,
+                                                    const InstanceBoxes::Key& key, size_t y,
+                                                    NodeId select, uint32_t depth,
+                                                    const double* frame, uint64_t path) {
     std::unique_ptr<UnrolledInstance> x;
     try {
         const uint64_t maxVisits =
@@ -365,6 +374,7 @@ const UnrolledInstance* UnrollCache::Reader::expand(Shard& s, Entry& e, size_t y
         e.instance = std::move(x);
         e.referenced.store(true, std::memory_order_relaxed);  // (the one just built stays)
         e.state = Entry::State::Built;
+        cache_.filterAdd(key, +1);
     }
     ++expansions_;
     cache_.expansions_.fetch_add(1, std::memory_order_relaxed);

@@ -88,6 +88,11 @@ class UnrollCache {
     size_t budget() const { return budget_.load(std::memory_order_relaxed); }
     // The largest instance kept (an eighth of the budget reached).
     size_t maxInstanceBytes() const;
+    // Whether an instance under this key may be built now: false when none with its filter
+    // slot is (see built()); true for every built one.
+    bool mayBeBuilt(const InstanceBoxes::Key& key) const {
+        return builtFilter_[filterSlot(key)].load(std::memory_order_relaxed) != 0;
+    }
     // Where the budget starts (unless told).
     static constexpr size_t kStartBytes = size_t{2} << 20;
 
@@ -118,6 +123,20 @@ class UnrollCache {
     static constexpr size_t kShards = 64;
 
     Shard& shardOf(const InstanceBoxes::Key& k) const;
+    // The filter of built instances: per slot (bits of the key that neither the shards nor
+    // their maps use), how many built instances have it, so that built() knows most misses
+    // without a shard's lock and map (the walk asks at every S-node of an expanded level,
+    // and few of those instances are built at a time). Changed under the shard's write
+    // lock as an entry becomes Built or loses its instance; read without it: a reader that
+    // misses an instance built a moment ago walks the graph below it, as before the build.
+    static constexpr size_t kFilterSlots = 4096;
+    static size_t filterSlot(const InstanceBoxes::Key& k) {
+        return static_cast<size_t>(k.b >> 40) & (kFilterSlots - 1);
+    }
+    void filterAdd(const InstanceBoxes::Key& k, int delta) {
+        builtFilter_[filterSlot(k)].fetch_add(static_cast<uint32_t>(delta),
+                                              std::memory_order_relaxed);
+    }
     size_t yieldIndex(NodeId select, uint32_t depth) const;
     void evict();
     double predictedBytes(NodeId select, uint32_t depth, double maxPerVisit = 1e300) const;
@@ -137,6 +156,7 @@ class UnrollCache {
     std::atomic<size_t> budget_;
     const uint32_t levels_;
     std::unique_ptr<Shard[]> shards_;
+    std::unique_ptr<std::atomic<uint32_t>[]> builtFilter_;
     std::unique_ptr<Yield[]> yield_;
     std::atomic<size_t> bytes_{0}, entries_{0};
     std::atomic<uint64_t> expansions_{0};
@@ -168,6 +188,11 @@ class UnrollCache::Reader {
     // The instance if it is expanded already (counted as a use), else nullptr: no note,
     // no expansion.
     const UnrolledInstance* built(const InstanceBoxes::Key& key, NodeId select, uint32_t depth);
+    // get() for an instance that built() has just not found (the walk asks built() first,
+    // then tests the instance's box): its meeting, which leaves a note or expands it, without
+    // looking for it as a built one again. The same result as get().
+    const UnrolledInstance* meet(const InstanceBoxes::Key& key, NodeId select, uint32_t depth,
+                                 const double* frame, uint64_t path);
 
     UnrolledInstance::Scratch& scratch() { return scratch_; }
     uint64_t expansions() const { return expansions_; }  // made by this thread
@@ -180,8 +205,9 @@ class UnrollCache::Reader {
         cache_.retired_.pin(*slot_);
         pinned_ = true;
     }
-    const UnrolledInstance* expand(Shard& s, Entry& e, size_t y, NodeId select, uint32_t depth,
-                                   const double* frame, uint64_t path);
+    const UnrolledInstance* expand(Shard& s, Entry& e, const InstanceBoxes::Key& key, size_t y,
+                                   NodeId select, uint32_t depth, const double* frame,
+                                   uint64_t path);
     void used(size_t y);
     void missed(size_t y);
 

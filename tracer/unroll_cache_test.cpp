@@ -126,6 +126,40 @@ TEST(UnrollCache, AnInstanceEvictedWhileInUseStaysIntactUntilItsReaderUnpins) {
     EXPECT_EQ(cache.retiredBytes(), 0u);
 }
 
+TEST(UnrollCache, BuiltFindsTheBuiltInstancesAndItsFilterForgetsTheEvictedOnes) {
+    auto c = compile(kFlower);
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
+    Flower f(*c->graph);
+    ASSERT_NE(f.slot, SIZE_MAX);
+    UnrollCache cache(scene, 8 * (flowerBytes(scene, f, 21) + 256));
+    UnrollCache::Reader r(cache);
+    f.frame[f.slot] = 21;
+    const InstanceBoxes::Key k = scene.instanceBoxes()->keyOf(f.select, f.frame.data(), kRootPath);
+    const UnrolledInstance* x = nullptr;
+    {
+        const UnrollCache::Pin pin(&r);
+        EXPECT_FALSE(cache.mayBeBuilt(k));
+        EXPECT_EQ(r.built(k, f.select, 1), nullptr);
+        EXPECT_EQ(r.meet(k, f.select, 1, f.frame.data(), kRootPath), nullptr);  // a note
+        x = r.meet(k, f.select, 1, f.frame.data(), kRootPath);  // expanded at the second
+        ASSERT_NE(x, nullptr);
+        EXPECT_TRUE(cache.mayBeBuilt(k));
+        EXPECT_EQ(r.built(k, f.select, 1), x);
+        EXPECT_EQ(r.meet(k, f.select, 1, f.frame.data(), kRootPath), x);
+    }
+    // Others fill the cache (as in the test above, but never with 21 petals: keys hold no
+    // depth): the flower leaves it, and the filter no longer holds it.
+    for (uint32_t depth = 2; depth <= 4; ++depth)
+        for (int p = 1; p < 21; ++p)
+            for (int i = 0; i < 2; ++i) {
+                const UnrollCache::Pin pin(&r);
+                f.get(r, p + depth / 8.0, depth);
+            }
+    ASSERT_EQ(cache.share(k), nullptr);  // (evicted: not built, whatever its level does)
+    EXPECT_FALSE(cache.mayBeBuilt(k));
+}
+
 TEST(UnrollCache, TracersOnSeveralThreadsStayWithinOneBudgetAndFindTheGraphWalksHits) {
     auto c = compile(kPlant);
     ASSERT_TRUE(c->graph);
