@@ -26,8 +26,10 @@
 // and paths as the walk, and hits the same surfaces bit for bit.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <new>
+#include <type_traits>
 #include <vector>
 
 #include "eval.h"
@@ -66,17 +68,22 @@ struct StepScratch {
     };
     // Room for a T-node's matrices, made by emplace() only when the step needs them (not a
     // std::optional: GCC 12 zero-fills an optional's 192 bytes on construction, and every
-    // node visit of every ray makes a StepScratch).
+    // node visit of every ray makes a StepScratch). emplace() leaves them unwritten: every
+    // T-step writes `forward` whole, and `inverse` whole unless it leaves Step::inverse
+    // null (Matrices() wrote two identities first: 1.2% of the terrain's instructions).
+    // Matrices, an aggregate, is an implicit-lifetime type: the bytes' array begun by the
+    // placement new holds it from then on.
     class MatrixRoom {
       public:
         MatrixRoom() {}
-        Matrices& emplace() { return *new (&room_.m) Matrices(); }
+        Matrices& emplace() {
+            return *std::launder(
+                reinterpret_cast<Matrices*>(new (room_) std::byte[sizeof(Matrices)]));
+        }
 
       private:
-        union Room {
-            Room() {}
-            Matrices m;
-        } room_;
+        static_assert(std::is_aggregate_v<Matrices> && std::is_trivially_destructible_v<Matrices>);
+        alignas(Matrices) std::byte room_[sizeof(Matrices)];
     };
     double* frame = nullptr;
     MatrixRoom matrices;

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "compile_test_util.h"
@@ -60,6 +62,46 @@ TEST(Semantics, AForwardOnlyStepSkipsTheInverseUnlessAMemoHasIt) {
     }
     EXPECT_EQ(computed, 3);
     EXPECT_EQ(fused, 2);
+}
+
+// StepScratch's room is left unwritten by emplace(): a T-step must write its matrices whole.
+// The room is filled with NaNs first; every step, from the graph and from the memo (a miss,
+// then a hit), gives exactly the matrices of the T-node.
+TEST(Semantics, ATStepWritesItsMatricesWholeOverWhatTheRoomHeld) {
+    auto c = compileUnfolded(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    const Semantics sem(g);
+    const StepMemoPlan plan(g);
+    StepMemo memo(g, plan);
+    std::vector<double> frame(g.slotCount(), 0.0);
+    for (size_t k = 0; k < g.slotCount(); ++k) frame[k] = g.slotNames[k] == "a" ? 2.0 : 3.0;
+    const PathState s{frame.data(), kRootPath, 1, 0};
+    auto soiled = [](StepScratch& scratch) {
+        StepScratch::Matrices& m = scratch.matrices.emplace();
+        std::fill_n(&m.forward.l[0][0], 9, std::nan(""));
+        std::fill_n(&m.inverse.l[0][0], 9, std::nan(""));
+        m.forward.t = m.inverse.t = {std::nan(""), std::nan(""), std::nan("")};
+    };
+    int checked = 0;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        if (g.nodes[n].kind != NodeKind::Transform || g.transforms[g.nodes[n].payload].constant)
+            continue;
+        SCOPED_TRACE(::testing::Message() << "node " << n);
+        const Affine forward = transformMatrix(g, n, EvalState{frame.data(), kRootPath});
+        const Affine inverse = forward.inverse();
+        for (int pass = 0; pass < 3; ++pass) {  // the graph; the memo's miss; its hit
+            StepScratch scratch;
+            if (pass > 0) scratch.memo = &memo;
+            soiled(scratch);
+            const Step st = sem.enter(n, s, scratch);
+            ASSERT_TRUE(st.forward && st.inverse);
+            EXPECT_TRUE(sameAffine(*st.forward, forward));
+            EXPECT_TRUE(sameAffine(*st.inverse, inverse));
+            ++checked;
+        }
+    }
+    EXPECT_EQ(checked, 9);
 }
 
 }  // namespace
