@@ -26,17 +26,28 @@ S 1
 1: S -> rotx(a*30) uscale(1 + b/10) sphere ∪ move(a, b, 1) scale(1, 2, 3) move(0, 1, 0) cube
 )";
 
+// The scene's graph with a = 2, b = 3 in the root frame, its semantics and a step memo.
+struct Steps {
+    explicit Steps(const Graph& g) : sem(g), plan(g), memo(g, plan), frame(g.slotCount(), 0.0) {
+        for (size_t k = 0; k < g.slotCount(); ++k) frame[k] = g.slotNames[k] == "a" ? 2.0 : 3.0;
+        s = PathState{frame.data(), kRootPath, 1, 0};
+    }
+    const Semantics sem;
+    const StepMemoPlan plan;
+    StepMemo memo;
+    std::vector<double> frame;
+    PathState s;
+};
+
 // Every T-step of the scene taken forward-only and in full, with and without a memo.
 TEST(Semantics, AForwardOnlyStepSkipsTheInverseUnlessAMemoHasIt) {
     auto c = compileUnfolded(kScene);  // (folded, a and b would be constants)
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
-    const Semantics sem(g);
-    const StepMemoPlan plan(g);
-    StepMemo memo(g, plan);
-    std::vector<double> frame(g.slotCount(), 0.0);
-    for (size_t k = 0; k < g.slotCount(); ++k) frame[k] = g.slotNames[k] == "a" ? 2.0 : 3.0;
-    const PathState s{frame.data(), kRootPath, 1, 0};
+    Steps t(g);
+    const Semantics& sem = t.sem;
+    StepMemo& memo = t.memo;
+    const PathState& s = t.s;
     int computed = 0, fused = 0;
     for (NodeId n = 0; n < g.nodes.size(); ++n) {
         if (g.nodes[n].kind != NodeKind::Transform) continue;
@@ -71,12 +82,10 @@ TEST(Semantics, ATStepWritesItsMatricesWholeOverWhatTheRoomHeld) {
     auto c = compileUnfolded(kScene);
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
-    const Semantics sem(g);
-    const StepMemoPlan plan(g);
-    StepMemo memo(g, plan);
-    std::vector<double> frame(g.slotCount(), 0.0);
-    for (size_t k = 0; k < g.slotCount(); ++k) frame[k] = g.slotNames[k] == "a" ? 2.0 : 3.0;
-    const PathState s{frame.data(), kRootPath, 1, 0};
+    Steps t(g);
+    const Semantics& sem = t.sem;
+    StepMemo& memo = t.memo;
+    const PathState& s = t.s;
     auto soiled = [](StepScratch& scratch) {
         StepScratch::Matrices& m = scratch.matrices.emplace();
         std::fill_n(&m.forward.l[0][0], 9, std::nan(""));
@@ -88,7 +97,7 @@ TEST(Semantics, ATStepWritesItsMatricesWholeOverWhatTheRoomHeld) {
         if (g.nodes[n].kind != NodeKind::Transform || g.transforms[g.nodes[n].payload].constant)
             continue;
         SCOPED_TRACE(::testing::Message() << "node " << n);
-        const Affine forward = transformMatrix(g, n, EvalState{frame.data(), kRootPath});
+        const Affine forward = transformMatrix(g, n, EvalState{t.frame.data(), kRootPath});
         const Affine inverse = forward.inverse();
         for (int pass = 0; pass < 3; ++pass) {  // the graph; the memo's miss; its hit
             StepScratch scratch;
