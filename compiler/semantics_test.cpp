@@ -45,18 +45,15 @@ TEST(Semantics, AForwardOnlyStepSkipsTheInverseUnlessAMemoHasIt) {
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
     Steps t(g);
-    const Semantics& sem = t.sem;
-    StepMemo& memo = t.memo;
-    const PathState& s = t.s;
     int computed = 0, fused = 0;
     for (NodeId n = 0; n < g.nodes.size(); ++n) {
         if (g.nodes[n].kind != NodeKind::Transform) continue;
         SCOPED_TRACE(::testing::Message() << "node " << n);
         StepScratch full, forward, remembered;
         forward.forwardOnly = remembered.forwardOnly = true;
-        remembered.memo = &memo;
-        const Step a = sem.enter(n, s, full), b = sem.enter(n, s, forward),
-                   m = sem.enter(n, s, remembered);
+        remembered.memo = &t.memo;
+        const Step a = t.sem.enter(n, t.s, full), b = t.sem.enter(n, t.s, forward),
+                   m = t.sem.enter(n, t.s, remembered);
         ASSERT_TRUE(a.forward && a.inverse && b.forward && m.forward && m.inverse);
         EXPECT_TRUE(sameAffine(*a.forward, *b.forward));
         EXPECT_TRUE(sameAffine(*a.forward, *m.forward));
@@ -83,9 +80,6 @@ TEST(Semantics, ATStepWritesItsMatricesWholeOverWhatTheRoomHeld) {
     ASSERT_TRUE(c->graph) << c->errors();
     const Graph& g = *c->graph;
     Steps t(g);
-    const Semantics& sem = t.sem;
-    StepMemo& memo = t.memo;
-    const PathState& s = t.s;
     auto soiled = [](StepScratch& scratch) {
         StepScratch::Matrices& m = scratch.matrices.emplace();
         std::fill_n(&m.forward.l[0][0], 9, std::nan(""));
@@ -101,9 +95,9 @@ TEST(Semantics, ATStepWritesItsMatricesWholeOverWhatTheRoomHeld) {
         const Affine inverse = forward.inverse();
         for (int pass = 0; pass < 3; ++pass) {  // the graph; the memo's miss; its hit
             StepScratch scratch;
-            if (pass > 0) scratch.memo = &memo;
+            if (pass > 0) scratch.memo = &t.memo;
             soiled(scratch);
-            const Step st = sem.enter(n, s, scratch);
+            const Step st = t.sem.enter(n, t.s, scratch);
             ASSERT_TRUE(st.forward && st.inverse);
             EXPECT_TRUE(sameAffine(*st.forward, forward));
             EXPECT_TRUE(sameAffine(*st.inverse, inverse));
