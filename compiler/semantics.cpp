@@ -1,6 +1,8 @@
 // Entering a node of the cyclic graph: see semantics.h.
 #include "semantics.h"
 
+#include <bit>
+
 #include "primitive_table.h"
 
 namespace pcsg {
@@ -57,6 +59,19 @@ Affine Semantics::forwardThrough(const Affine& outer, NodeId n, const Step& st) 
     for (NodeId k = n; k != st.child; k = g_.child(k))
         m = m * g_.transforms[g_.nodes[k].payload].matrix;
     return m;
+}
+
+bool Semantics::identityTimesIsExact(const Affine& m) {
+    constexpr uint64_t kMinusZero = uint64_t{1} << 63, kExponent = uint64_t{0x7ff} << 52;
+    bool exact = true;
+    auto check = [&](double x) {
+        const uint64_t b = std::bit_cast<uint64_t>(x);
+        exact = exact && b != kMinusZero && (b & kExponent) != kExponent;
+    };
+    for (const auto& row : m.l)
+        for (double x : row) check(x);
+    check(m.t.x), check(m.t.y), check(m.t.z);
+    return exact;
 }
 
 uint32_t Semantics::primitiveArgs(NodeId n, const PathState& s, double* out) const {

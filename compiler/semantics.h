@@ -154,6 +154,20 @@ class Semantics {
     // T-nodes were folded into constants.
     Affine forwardThrough(const Affine& outer, NodeId n, const Step& st) const;
 
+    // forwardThrough(Affine::identity(), n, st) bit for bit, without the product where it is
+    // the step's own matrix (a world that restarts at the identity below an S-node: the
+    // prefill's walk, an expansion's build): returns *st.forward itself then, else writes
+    // the product into `room` and returns it. The one rule: a fused chain's matrix is that
+    // product (the constructor multiplies it out from the identity the same way); a
+    // parameter T-node's M is identity * M where M holds no -0 (+0 + -0 is +0) and no
+    // infinity or NaN (0 * inf is NaN), else it is multiplied.
+    const Affine& fromIdentity(NodeId n, const Step& st, Affine& room) const {
+        if (fused_[n].target != kNone || identityTimesIsExact(*st.forward)) return *st.forward;
+        return room = forwardThrough(Affine::identity(), n, st);
+    }
+    // Whether identity * m has m's bits (the test fromIdentity makes).
+    static bool identityTimesIsExact(const Affine& m);
+
     // The state of operand i of an operator.
     static PathState operand(const PathState& s, uint32_t i) {
         return PathState{s.frame, pathChild(s.path, i), s.depth, s.material, s.paint};

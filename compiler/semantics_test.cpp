@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "compile_test_util.h"
 #include "step_memo.h"
@@ -105,6 +106,51 @@ TEST(Semantics, ATStepWritesItsMatricesWholeOverWhatTheRoomHeld) {
         }
     }
     EXPECT_EQ(checked, 9);
+}
+
+// fromIdentity is forwardThrough(identity) bit for bit, and the step's own matrix (no copy)
+// where that is exact: at a parameter T-node, matrices with -0, an infinity or a NaN (whose
+// products with the identity differ from them) are multiplied, a plain one is not; a fused
+// chain's matrix is taken as it is.
+TEST(Semantics, FromIdentityIsTheProductWithTheIdentityBitForBit) {
+    auto c = compileUnfolded(kScene);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    Steps t(g);
+    NodeId param = kNone, chain = kNone;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        if (g.nodes[n].kind != NodeKind::Transform) continue;
+        NodeId& which = g.transforms[g.nodes[n].payload].constant ? chain : param;
+        if (which == kNone) which = n;
+    }
+    ASSERT_NE(param, kNone);
+    ASSERT_NE(chain, kNone);
+    const double inf = std::numeric_limits<double>::infinity();
+    const Affine minusZero = Affine::translate({-0.0, 1, 2}), infinite = Affine::scale({2, inf, 1}),
+                 notANumber = Affine::translate({1, std::nan(""), 3}),
+                 plain = Affine::translate({1, 2, 3}) * Affine::scale({2, -1, 0.5});
+    const Affine* const differing[] = {&minusZero, &infinite, &notANumber};
+    for (int k = 0; k < 3; ++k) {
+        SCOPED_TRACE(::testing::Message() << "matrix " << k);
+        const Affine* m = differing[k];
+        Step st;
+        st.forward = m;
+        Affine room;
+        const Affine& w = t.sem.fromIdentity(param, st, room);
+        const Affine product = t.sem.forwardThrough(Affine::identity(), param, st);
+        EXPECT_FALSE(sameAffine(product, *m));  // (the case is one where the product differs)
+        EXPECT_TRUE(sameAffine(w, product));
+        EXPECT_EQ(&w, &room);
+    }
+    Step st;
+    st.forward = &plain;
+    Affine room;
+    EXPECT_EQ(&t.sem.fromIdentity(param, st, room), &plain);
+    EXPECT_TRUE(sameAffine(plain, t.sem.forwardThrough(Affine::identity(), param, st)));
+    StepScratch scratch;
+    const Step fused = t.sem.enter(chain, t.s, scratch);
+    EXPECT_EQ(&t.sem.fromIdentity(chain, fused, room), fused.forward);
+    EXPECT_TRUE(sameAffine(*fused.forward, t.sem.forwardThrough(Affine::identity(), chain, fused)));
 }
 
 }  // namespace

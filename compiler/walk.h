@@ -35,7 +35,6 @@
 #pragma once
 
 #include <algorithm>
-#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -189,35 +188,15 @@ class Walker {
         c.depth = st.state.depth;
         c.material = st.state.material;
         if (st.forward) {
-            c.world = c.identity ? fromIdentity(n, st) : sem_.forwardThrough(c.world, n, st);
+            Affine room;  // (from the identity: the step's own matrix where that is exact)
+            c.world =
+                c.identity ? sem_.fromIdentity(n, st, room) : sem_.forwardThrough(c.world, n, st);
             c.identity = false;
         }
         if (kind == NodeKind::Select && localSelectFrames()) {
             c.world = Affine::identity();
             c.identity = true;
         }
-    }
-
-    // forwardThrough(identity, n, st) without its products where they give the step's own
-    // matrix bit for bit (below every S-node of a sink with local frames, the first T-step
-    // is such a product): a fused chain's matrix is that product (Semantics multiplies it
-    // out from the identity the same way); identity * M is M where M holds no -0 (+0 + -0
-    // is +0) and no infinity or NaN (0 * inf is NaN), else it is multiplied.
-    Affine fromIdentity(NodeId n, const Step& st) const {
-        if (sem_.nodesInStep(n) > 1 || identityTimesIsExact(*st.forward)) return *st.forward;
-        return sem_.forwardThrough(Affine::identity(), n, st);
-    }
-    static bool identityTimesIsExact(const Affine& m) {
-        constexpr uint64_t kMinusZero = uint64_t{1} << 63, kExponent = uint64_t{0x7ff} << 52;
-        bool exact = true;
-        auto check = [&](double x) {
-            const uint64_t b = std::bit_cast<uint64_t>(x);
-            exact = exact && b != kMinusZero && (b & kExponent) != kExponent;
-        };
-        for (const auto& row : m.l)
-            for (double x : row) check(x);
-        check(m.t.x), check(m.t.y), check(m.t.z);
-        return exact;
     }
 
     // A C-node's new frame on the arena (not cleared: the C-step writes all of it); its offset.

@@ -410,8 +410,7 @@ class Analysis {
 }  // namespace
 
 // b enlarged on every finite side by rel * (finite extent) + abs * max(|ends|, 1).
-Box growBox(const Box& b, double rel, double abs) {
-    if (b.isEmpty()) return b;
+Box growUnboundedBox(const Box& b, double rel, double abs) {
     Box r = b;
     for (int i = 0; i < 3; ++i) {
         const double lo = b.lo[i], hi = b.hi[i];
@@ -424,10 +423,6 @@ Box growBox(const Box& b, double rel, double abs) {
         r.hi[i] = hi + m;
     }
     return r;
-}
-
-Box paddedBox(const Box& b) {
-    return growBox(b, 1e-9, 1e-10);
 }
 
 Bounds computeBounds(const Graph& g, const BoundsOptions& options) {

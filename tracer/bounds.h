@@ -32,6 +32,8 @@
 // transformation to a child frame never culls a surface that touches its box.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -75,10 +77,30 @@ struct BoundsOptions {
 
 Bounds computeBounds(const Graph& g, const BoundsOptions& options = {});
 
+// b (not empty) enlarged along axis i as growBox does, where an end is infinite.
+Box growUnboundedBox(const Box& b, double rel, double abs);
+
 // b enlarged on every finite side by rel * (finite extent) + abs * max(|ends|, 1).
-Box growBox(const Box& b, double rel, double abs);
+// Inline for the bounded boxes (an expansion grows one per node and operand): one test
+// of the extents stands for the tests of both ends, the same operations otherwise.
+inline Box growBox(const Box& b, double rel, double abs) {
+    if (b.isEmpty()) return b;
+    const Vec3 extent = b.hi - b.lo;  // (finite: then both ends are)
+    if (!isFinite(extent)) return growUnboundedBox(b, rel, abs);
+    Box r;
+    for (int i = 0; i < 3; ++i) {
+        const double lo = b.lo[i], hi = b.hi[i];
+        const double big = std::max(std::max(1.0, std::fabs(lo)), std::fabs(hi));
+        const double m = rel * extent[i] + abs * big;
+        r.lo[i] = lo - m;
+        r.hi[i] = hi + m;
+    }
+    return r;
+}
 // The padding every box the tracer tests gets, so that rounding in the ray's
 // transformation to a child frame never culls a surface that touches its box.
-Box paddedBox(const Box& b);
+inline Box paddedBox(const Box& b) {
+    return growBox(b, 1e-9, 1e-10);
+}
 
 }  // namespace pcsg::tracer

@@ -7,7 +7,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "interval.h"
 #include "primitives.h"
@@ -97,6 +101,41 @@ void checkScene(const char* text, BoundsOptions opt = {}, size_t minInstances = 
     const auto insts = Expander(g).run();
     ASSERT_GE(insts.size(), minInstances);
     EXPECT_GT(checkSound(g, b, insts), 0u);
+}
+
+// growBox by its rule, computed here side by side: each finite end moves out by
+// rel * (finite extent) + abs * max(|ends|, 1), an infinite end stays. The boxes: bounded
+// (the inline path, ends on either side of 1 and of 0), one or both ends infinite on an
+// axis, and an extent that overflows though both ends are finite.
+TEST(Bounds, GrowBoxMovesEachFiniteSideByItsRule) {
+    const double inf = std::numeric_limits<double>::infinity(), rel = 1e-7, abs = 1e-9;
+    auto byRule = [&](const Box& b) {
+        Box r = b;
+        for (int i = 0; i < 3; ++i) {
+            const double lo = b.lo[i], hi = b.hi[i];
+            const double extent = std::isfinite(hi - lo) ? hi - lo : 0.0;
+            const double big = std::max({1.0, std::isfinite(lo) ? std::fabs(lo) : 0.0,
+                                         std::isfinite(hi) ? std::fabs(hi) : 0.0});
+            const double m = rel * extent + abs * big;
+            r.lo[i] = lo - m, r.hi[i] = hi + m;
+        }
+        return r;
+    };
+    const Box boxes[] = {
+        {{-3.5, 0.25, -0.5}, {2, 0.75, 0.5}}, {{-1e300, 1, 2}, {1e300, 5, 3}},
+        {{-1.5e308, 1, 2}, {1.5e308, 5, 3}},  {{-inf, 1, 2}, {4, 5, 3}},
+        {{-inf, -inf, 2}, {inf, 5, inf}},     {{0, 0, 0}, {0, 0, 0}},
+    };
+    for (const Box& b : boxes) {
+        const Box grown = growBox(b, rel, abs), expected = byRule(b);
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_EQ(std::bit_cast<uint64_t>(grown.lo[i]),
+                      std::bit_cast<uint64_t>(expected.lo[i]));
+            EXPECT_EQ(std::bit_cast<uint64_t>(grown.hi[i]),
+                      std::bit_cast<uint64_t>(expected.hi[i]));
+        }
+    }
+    EXPECT_TRUE(growBox(Box::empty(), rel, abs).isEmpty());
 }
 
 TEST(Bounds, SierpinskiIsSoundAndTight) {

@@ -265,10 +265,11 @@ class Unroller {
             choices_.push_back(kRuleBit | st.rule);
         }
         if (st.inverse) pending_.push_back(inverseIndex(n, *st.inverse));
-        // (from the identity: the step's own matrix, not a product with the identity)
+        // (from the identity: the step's own matrix where that is exact, Semantics' rule)
         Affine composed;
         const Affine* next = edge;
-        if (st.forward) next = edge ? &(composed = *edge * *st.forward) : st.forward;
+        if (st.forward)
+            next = edge ? &(composed = *edge * *st.forward) : &sem_.fromIdentity(n, st, composed);
         const uint32_t r = build(st.child, st.state, pendingBase, next);
         if (st.inverse) pending_.pop_back();
         if (kind == NodeKind::Select) choices_.pop_back();
