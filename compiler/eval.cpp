@@ -268,7 +268,9 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
 
 }  // namespace
 
-double evalExpr(const Graph& g, ExprId id, EvalState s) {
+namespace {
+// evalExpr(), inlined where a T-node's arguments are read one by one (move(0, 0, z1)).
+[[gnu::always_inline]] inline double evalInline(const Graph& g, ExprId id, EvalState s) {
     const Expr& e = g.exprs[id];
     double v;
     if (e.fast != kNoFast) {
@@ -286,6 +288,11 @@ double evalExpr(const Graph& g, ExprId id, EvalState s) {
     }
     std::vector<double> stack(e.maxStack);
     return run(g, e, s, stack.data());
+}
+}  // namespace
+
+double evalExpr(const Graph& g, ExprId id, EvalState s) {
+    return evalInline(g, id, s);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -429,17 +436,27 @@ std::optional<Affine> constantTransform(TransformOp op, const double* a) {
 
 namespace {
 
-// The values of a T-node's arguments, each checked finite; and its matrix. move() and
-// zshear() of finite arguments have the determinant 1 exactly (its products of the zeros and
-// ones of the identity are exact), so they need no singularity test.
-Affine checkedTransform(const Graph& g, NodeId n, EvalState s, double* a) {
-    const Transform& t = g.transforms[g.nodes[n].payload];
+// The values of a T-node's arguments into `a`, each checked finite in order. Its program
+// (Transform::fast) computes each argument as evalExpr() would, all in one run of the
+// machine; where it stops (an unassigned read), the arguments are evaluated one by one,
+// which reports the first error as it always did.
+void argumentsOf(const Graph& g, const Transform& t, EvalState s, double* a) {
+    double unused;
+    const bool all = t.fast != kNoFast && runFast(g, t.fast, s.frame, a, s.path, unused);
     for (uint32_t i = 0; i < t.argCount; ++i) {
         const ExprId id = g.args[t.firstArg + i];
-        a[i] = evalExpr(g, id, s);
+        if (!all) a[i] = evalInline(g, id, s);
         if (!std::isfinite(a[i]))
             nonFinite(g, g.exprs[id], a[i], "the transformation argument", s.frame);
     }
+}
+
+// A T-node's arguments, checked, and its matrix. move() and zshear() of finite arguments
+// have the determinant 1 exactly (its products of the zeros and ones of the identity are
+// exact), so they need no singularity test.
+Affine checkedTransform(const Graph& g, NodeId n, EvalState s, double* a) {
+    const Transform& t = g.transforms[g.nodes[n].payload];
+    argumentsOf(g, t, s, a);
     if (t.op == TransformOp::Move || t.op == TransformOp::ZShear) return makeTransform(t.op, a);
     const FileLoc loc = t.argCount ? g.exprs[g.args[t.firstArg]].loc : g.nodes[n].loc;
     if (t.op == TransformOp::Rot && a[0] == 0 && a[1] == 0 && a[2] == 0)

@@ -230,6 +230,33 @@ uint32_t translateCalc(Graph& g, const Calc& c) {
     return start;
 }
 
+// A lone constant or parameter: evalExpr() reads it without the machine.
+bool loneLeaf(const Graph& g, ExprId id) {
+    const Expr& e = g.exprs[id];
+    return e.end == e.begin + 1 && isLeaf(g.code[e.begin].op);
+}
+
+// A T-node's arguments as one program, argument i stored to out[i] (the frame read is not
+// `out`, so no StoreKeep); none when every argument is a lone leaf or the machine cannot
+// run one of them.
+uint32_t translateArgs(Graph& g, const Transform& t) {
+    if (t.constant) return kNoFast;
+    bool leavesOnly = true;
+    for (uint32_t i = 0; i < t.argCount; ++i) leavesOnly &= loneLeaf(g, g.args[t.firstArg + i]);
+    if (leavesOnly) return kNoFast;
+    const auto start = static_cast<uint32_t>(g.fastCode.size());
+    for (uint32_t i = 0; i < t.argCount; ++i) {
+        const Expr& e = g.exprs[g.args[t.firstArg + i]];
+        if (!translate(g, e.begin, e.end)) {
+            g.fastCode.resize(start);
+            return kNoFast;
+        }
+        g.fastCode.push_back(FastInstr{FastOp::Store, 0, 0, i});
+    }
+    g.fastCode.push_back(FastInstr{FastOp::End});
+    return start;
+}
+
 #define PCSG_FAST_NAME(name) #name,
 constexpr const char* kOpNames[] = {PCSG_FAST_OPS(PCSG_FAST_NAME)};
 #undef PCSG_FAST_NAME
@@ -303,12 +330,14 @@ void dropFastCode(Graph& g) {
     g.fastCode.clear();
     for (Expr& e : g.exprs) e.fast = kNoFast;
     for (Calc& c : g.calcs) c.fast = kNoFast;
+    for (Transform& t : g.transforms) t.fast = kNoFast;
 }
 
 void buildFastCode(Graph& g) {
     dropFastCode(g);
     for (Expr& e : g.exprs) e.fast = translateExpr(g, e);
     for (Calc& c : g.calcs) c.fast = translateCalc(g, c);
+    for (Transform& t : g.transforms) t.fast = translateArgs(g, t);
 }
 
 std::string dumpFastExpr(const Graph& g, ExprId e) {

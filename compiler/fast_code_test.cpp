@@ -12,6 +12,7 @@
 
 #include "compile_test_util.h"
 #include "eval.h"
+#include "eval_core.h"
 #include "raw_code_test_util.h"
 
 namespace pcsg {
@@ -319,6 +320,102 @@ TEST(FastCode, SimultaneousCalcsReadTheIncomingFrame) {
     EXPECT_EQ(in, (std::vector<double>{5, 1}));
 }
 
+// T-nodes whose arguments are sums, products, a rand() and lone leaves; w is unassigned.
+constexpr const char* kTransforms =
+    "{x = 1; y = 2; z = 3} (move(x-y, 2*z+x, y) zshear(x-z, y*z) rot(x+1, y, 0, x*y)"
+    " scale(x, y+z, 2+rand()) move(x, 0, y) sphere ∪ {w = 0} move(x*2, y-w, x) cube)\n";
+
+// The graph whose T-nodes evaluate each argument alone, as they did before their programs.
+Graph argumentsAlone(const Graph& g) {
+    Graph a = g;
+    for (Transform& t : a.transforms) t.fast = kNoFast;
+    return a;
+}
+
+// A T-node's two matrices as bits, or the error it reports.
+std::pair<std::string, std::vector<uint64_t>> pairOf(const Graph& g, NodeId n, EvalState s) {
+    Affine f, i;
+    std::pair<std::string, std::vector<uint64_t>> r;
+    r.first = errorOf(g, [&] { transformPair(g, n, s, f, i); });
+    for (const Affine* m : {&f, &i}) {
+        for (const auto& row : m->l)
+            for (double v : row) r.second.push_back(std::bit_cast<uint64_t>(v));
+        for (double v : {m->t.x, m->t.y, m->t.z}) r.second.push_back(std::bit_cast<uint64_t>(v));
+    }
+    if (!r.first.empty()) r.second.clear();
+    return r;
+}
+
+// A random argument: finite (zeros of both signs, subnormals, wide exponents) or, in one
+// frame of eight, NaN or an infinity.
+double randomArgument(std::mt19937_64& rng, bool nonFinite) {
+    const double special[] = {0.0, -0.0, 1.0, -1.0, 4.9e-324, -1e-310, 1e300, kInf, std::nan("")};
+    std::uniform_real_distribution<double> wide(-1e3, 1e3);
+    if (rng() % 4 == 0) return special[rng() % (std::size(special) - (nonFinite ? 0 : 2))];
+    return std::ldexp(wide(rng), static_cast<int>(rng() % 80) - 40);
+}
+
+TEST(FastCode, ATNodesArgumentsAsOneProgramGiveEachArgumentsValueBitForBit) {
+    auto c = testing::compileUnfolded(kTransforms);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    const Graph alone = argumentsAlone(g), plain = plainOf(g);
+    std::vector<NodeId> nodes;
+    size_t programs = 0;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        if (g.nodes[n].kind != NodeKind::Transform) continue;
+        nodes.push_back(n);
+        programs += g.transforms[g.nodes[n].payload].fast != kNoFast;
+    }
+    ASSERT_EQ(nodes.size(), 6u);
+    EXPECT_EQ(programs, 5u) << "move(x, 0, y) reads its leaves without a program";
+    std::mt19937_64 rng(29);
+    std::vector<double> frame(g.slotCount());
+    size_t errors = 0;
+    for (int k = 0; k < 4000; ++k) {
+        initFrame(g, frame.data());
+        for (Slot s = 0; s < g.slotCount(); ++s)
+            if (g.slotNames[s] != "w") frame[s] = randomArgument(rng, k % 8 == 0);
+        const EvalState s{frame.data(), pathChild(kRootPath, k)};
+        for (NodeId n : nodes) {
+            const auto fast = pairOf(g, n, s);
+            errors += !fast.first.empty();
+            ASSERT_EQ(fast, pairOf(alone, n, s)) << describeFrame(g, frame.data());
+            ASSERT_EQ(fast, pairOf(plain, n, s)) << describeFrame(g, frame.data());
+        }
+    }
+    EXPECT_GT(errors, 500u) << "the non-finite and unassigned arguments' errors are compared";
+}
+
+TEST(FastCode, ATNodesProgramStoresEveryArgument) {
+    auto c = testing::compileUnfolded(kTransforms);
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    for (Slot s = 0; s < g.slotCount(); ++s)
+        if (g.slotNames[s] != "w") frame[s] = 1.5 + s;
+    const EvalState s{frame.data(), kRootPath};
+    size_t run = 0, stopped = 0;
+    for (const Transform& t : g.transforms) {
+        if (t.fast == kNoFast) continue;
+        std::vector<double> out(t.argCount, std::nan("7"));
+        double unused;
+        if (!runFast(g, t.fast, frame.data(), out.data(), kRootPath, unused)) {
+            ++stopped;  // move(x*2, y-w, x) reads the unassigned w
+            continue;
+        }
+        ++run;
+        for (uint32_t i = 0; i < t.argCount; ++i) {
+            const ExprId e = g.args[t.firstArg + i];
+            EXPECT_EQ(std::bit_cast<uint64_t>(out[i]), std::bit_cast<uint64_t>(evalExpr(g, e, s)))
+                << "argument " << i << " '" << g.exprs[e].text << "' not stored";
+        }
+    }
+    EXPECT_EQ(run, 4u);
+    EXPECT_EQ(stopped, 1u);
+}
+
 TEST(FastCode, ChangingTheCodeDropsTheFastForm) {
     auto c = withExprs({"x + 1"});
     ASSERT_TRUE(c->graph);
@@ -328,6 +425,7 @@ TEST(FastCode, ChangingTheCodeDropsTheFastForm) {
     EXPECT_TRUE(g.fastCode.empty());
     for (const Expr& e : g.exprs) EXPECT_EQ(e.fast, kNoFast);
     for (const Calc& k : g.calcs) EXPECT_EQ(k.fast, kNoFast);
+    for (const Transform& t : g.transforms) EXPECT_EQ(t.fast, kNoFast);
 }
 
 }  // namespace

@@ -172,6 +172,9 @@ struct Transform {
     uint32_t firstArg = 0, argCount = 0;  // Graph::args[firstArg, firstArg+argCount)
     bool constant = false;                // all arguments constant: `matrix` is valid
     Affine matrix;                        // precomputed when constant
+    // All its arguments as one program in Graph::fastCode, argument i stored to out[i]: when
+    // one of them is more than a lone constant or parameter (zshear(z2-z1, z3-z1)).
+    uint32_t fast = kNoFast;
 };
 
 struct Assignment {

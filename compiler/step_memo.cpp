@@ -2,8 +2,11 @@
 #include "step_memo.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstring>
+#include <type_traits>
+#include <utility>
 
 namespace pcsg {
 
@@ -177,34 +180,81 @@ void StepMemo::endWindow() {
     windowEnd_ = hits_ + misses_ + growth_.window;
 }
 
-bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, uint64_t*& e) {
-    if (hits_ + misses_ == windowEnd_) endWindow();
-    uint64_t key[StepMemoPlan::kMaxReads];
-    const uint32_t* reads = plan_.reads(p);
-    uint64_t h = add(0, n);
-    uint32_t i = 0;
-    for (; i < p.readCount && reads[i] >= StepMemoPlan::kFrame; ++i) {  // clock, frame first
-        key[i] = bits(readValue(g_, reads[i], in.frame));
-        h = add(h, key[i]);
-    }
-    for (; i < p.readCount; ++i) {
-        key[i] = bits(in.frame[reads[i]]);
-        h = add(h, key[i]);
-    }
-    const uint64_t path = p.usesPath ? in.path : 0;
-    if (p.usesPath) h = add(h, path);
-    e = table_.data() + (finish(h) & mask_) * stride_;
-    bool same = e[0] == n && e[1] == path;
-    for (uint32_t i = 0; same && i < p.readCount; ++i) same = e[kKey + i] == key[i];
-    if (same) {
-        ++hits_;
-        return true;
-    }
-    ++misses_;
+namespace {
+
+// An entry's words before its key: the node and the path (StepMemo::kKey).
+constexpr uint32_t kEntryKey = 2;
+
+// What a lookup knows besides the key: the node, the path it is keyed by, the table.
+struct Probe {
+    uint64_t node, path;
+    bool usesPath;
+    uint64_t* table;
+    uint32_t mask;
+    size_t stride;
+};
+
+// The entry for a key of `count` values hashed into h (the node's and the values' hash,
+// not yet the path's): found (true), or made ready to fill (false, the key written). A
+// count known at compile time (std::integral_constant) unrolls the comparison.
+template <class Count>
+bool settle(const Probe& q, uint64_t h, const uint64_t* key, Count count, uint64_t*& e) {
+    const uint32_t n = count;
+    if (q.usesPath) h = add(h, q.path);
+    e = q.table + (finish(h) & q.mask) * q.stride;
+    uint64_t differ = (e[0] ^ q.node) | (e[1] ^ q.path);
+    for (uint32_t i = 0; i < n; ++i) differ |= e[kEntryKey + i] ^ key[i];
+    if (differ == 0) return true;
     e[0] = kNone;  // filled in by the caller once the step has succeeded
-    e[1] = path;
-    for (uint32_t i = 0; i < p.readCount; ++i) e[kKey + i] = key[i];
+    e[1] = q.path;
+    for (uint32_t i = 0; i < n; ++i) e[kEntryKey + i] = key[i];
     return false;
+}
+
+// A key of N slots (no clock or frame), read and hashed unrolled: no bound test per value.
+template <uint32_t N>
+bool probeSlots(const Probe& q, const uint32_t* reads, const double* frame, uint64_t*& e) {
+    uint64_t key[N ? N : 1];
+    uint64_t h = add(0, q.node);
+    for (uint32_t i = 0; i < N; ++i) {
+        key[i] = bits(frame[reads[i]]);
+        h = add(h, key[i]);
+    }
+    return settle(q, h, key, std::integral_constant<uint32_t, N>(), e);
+}
+
+using ProbeSlots = bool (*)(const Probe&, const uint32_t*, const double*, uint64_t*&);
+template <uint32_t... N>
+constexpr std::array<ProbeSlots, sizeof...(N)> probesFor(std::integer_sequence<uint32_t, N...>) {
+    return {probeSlots<N>...};
+}
+constexpr auto kProbeSlots =
+    probesFor(std::make_integer_sequence<uint32_t, StepMemoPlan::kMaxReads + 1>());
+
+// A key that reads clock or frame (first) and then slots; out of lookup()'s way.
+[[gnu::noinline]] bool probeWithTime(const Graph& g, const Probe& q, const uint32_t* reads,
+                                     uint32_t count, const double* frame, uint64_t*& e) {
+    uint64_t key[StepMemoPlan::kMaxReads];
+    uint64_t h = add(0, q.node);
+    for (uint32_t i = 0; i < count; ++i) {
+        key[i] = bits(readValue(g, reads[i], frame));
+        h = add(h, key[i]);
+    }
+    return settle(q, h, key, count, e);
+}
+
+}  // namespace
+
+bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, uint64_t*& e) {
+    static_assert(kKey == kEntryKey);
+    if (hits_ + misses_ == windowEnd_) endWindow();
+    const uint32_t* reads = plan_.reads(p);
+    const Probe q{n, p.usesPath ? in.path : 0, p.usesPath, table_.data(), mask_, stride_};
+    const bool found = p.readCount == 0 || reads[0] < StepMemoPlan::kFrame
+                           ? kProbeSlots[p.readCount](q, reads, in.frame, e)
+                           : probeWithTime(g_, q, reads, p.readCount, in.frame, e);
+    ++(found ? hits_ : misses_);
+    return found;
 }
 
 uint32_t StepMemo::select(NodeId n, EvalState in) {

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstring>
 #include <random>
+#include <string>
 
 #include "compile_test_util.h"
 
@@ -95,6 +96,58 @@ TEST(StepMemo, ATinyTableEvictsButNeverMixesUpEntries) {
     StepMemo memo(*c->graph, plan, 1);  // two entries for all nodes
     checkAgainstDirect(*c->graph, memo, 200);
     EXPECT_GT(memo.misses(), 0u);
+}
+
+// C-nodes that read 1 to 16 slots (every length of key the lookup unrolls), in a chain, and
+// one that reads the clock first.
+std::string keysOfEveryLength() {
+    std::string text = "{", sum;
+    for (int i = 1; i <= 16; ++i)
+        text += "s" + std::to_string(i) + " = " + std::to_string(i) + "; ";
+    text += "r = 0} {r = clock + s1 + s2} ";
+    for (int k = 1; k <= 16; ++k) {
+        sum += (k > 1 ? " + s" : "s") + std::to_string(k);
+        text += "{r = " + sum + "} ";
+    }
+    return text + "sphere\n";
+}
+
+// A key's value changed: slot r of the frame, or the clock.
+void change(Graph& g, std::vector<double>& frame, uint32_t r, double v) {
+    if (r == StepMemoPlan::kClock)
+        g.time.clock = v;
+    else
+        frame[r] = v;
+}
+
+TEST(StepMemo, KeysOfEveryLengthHitOnlyWhenEveryValueIsTheSame) {
+    auto c = testing::compileUnfolded(keysOfEveryLength());
+    ASSERT_TRUE(c->graph) << c->errors();
+    Graph& g = *c->graph;
+    const StepMemoPlan plan(g);
+    uint32_t lengths = 0;
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        const StepMemoPlan::NodePlan& p = plan.of(n);
+        if (g.nodes[n].kind != NodeKind::Calc || !p.memoised) continue;
+        lengths |= 1u << p.readCount;
+        StepMemo memo(g, plan, 0);  // one entry: each lookup meets the key before it
+        std::vector<double> frame(g.slotCount(), 1.0), direct(g.slotCount()), got(g.slotCount());
+        g.time.clock = 1;
+        const EvalState s{frame.data(), kRootPath};
+        memo.calc(n, s, got.data());
+        memo.calc(n, s, got.data());
+        for (uint32_t j = 0; j < p.readCount; ++j) {  // each value alone differs: a miss
+            change(g, frame, plan.reads(p)[j], 2);
+            memo.calc(n, s, got.data());
+            applyCalc(g, n, s, direct.data());
+            ASSERT_TRUE(sameBits(direct.data(), got.data(), got.size())) << "value " << j;
+            change(g, frame, plan.reads(p)[j], 1);
+            memo.calc(n, s, got.data());
+        }
+        EXPECT_EQ(memo.hits(), 1u) << "node " << n << ", " << p.readCount << " values";
+        EXPECT_EQ(memo.misses(), 1u + 2 * p.readCount) << "node " << n;
+    }
+    EXPECT_EQ(lengths & 0x1fffeu, 0x1fffeu) << "keys of 1 to 16 values";
 }
 
 TEST(StepMemo, TheInstancePathIsPartOfTheKeyOnlyForRandomSteps) {
