@@ -192,7 +192,8 @@ struct Probe {
 // not yet the path's): found (true), or made ready to fill (false, the key written). A
 // count known at compile time (std::integral_constant) unrolls the comparison.
 template <class Count>
-bool settle(const Probe& q, uint64_t h, const uint64_t* key, Count count, uint64_t*& e) {
+[[gnu::always_inline]] inline bool settle(const Probe& q, uint64_t h, const uint64_t* key,
+                                          Count count, uint64_t*& e) {
     const uint32_t n = count;
     if (q.usesPath) h = add(h, q.path);
     e = q.table + (finish(h) & q.mask) * q.stride;
