@@ -46,12 +46,6 @@ void addReads(const Graph& g, ExprId id, std::vector<uint32_t>& reads, bool& use
     }
 }
 
-double readValue(const Graph& g, uint32_t r, const double* frame) {
-    if (r < StepMemoPlan::kFrame) [[likely]]  // (one test for the two time reads)
-        return frame[r];
-    return r == StepMemoPlan::kClock ? g.time.clock : g.time.frame;
-}
-
 // Doubles differ in their high bits (exponent and leading mantissa), so each value is
 // folded down as it is added, and the sum is finished with MurmurHash3's finaliser: the
 // table index takes the low bits.
@@ -198,7 +192,8 @@ struct Probe {
 // not yet the path's): found (true), or made ready to fill (false, the key written). A
 // count known at compile time (std::integral_constant) unrolls the comparison.
 template <class Count>
-bool settle(const Probe& q, uint64_t h, const uint64_t* key, Count count, uint64_t*& e) {
+[[gnu::always_inline]] inline bool settle(const Probe& q, uint64_t h, const uint64_t* key,
+                                          Count count, uint64_t*& e) {
     const uint32_t n = count;
     if (q.usesPath) h = add(h, q.path);
     e = q.table + (finish(h) & q.mask) * q.stride;
@@ -211,16 +206,29 @@ bool settle(const Probe& q, uint64_t h, const uint64_t* key, Count count, uint64
     return false;
 }
 
-// A key of N slots (no clock or frame), read and hashed unrolled: no bound test per value.
-template <uint32_t N>
-bool probeSlots(const Probe& q, const uint32_t* reads, const double* frame, uint64_t*& e) {
+// The value of a read of the time (StepMemoPlan::kClock or kFrame).
+double timeValue(const Time& t, uint32_t r) {
+    return r == StepMemoPlan::kClock ? t.clock : t.frame;
+}
+
+// A key of T reads of the time (clock or frame, first in the plan) and then N - T slots, read
+// and hashed unrolled: no bound test and no test for the time per value.
+template <uint32_t T, uint32_t N>
+bool probeKey(const Time& t, const Probe& q, const uint32_t* reads, const double* frame,
+              uint64_t*& e) {
     uint64_t key[N ? N : 1];
     uint64_t h = add(0, q.node);
     for (uint32_t i = 0; i < N; ++i) {
-        key[i] = bits(frame[reads[i]]);
+        key[i] = bits(i < T ? timeValue(t, reads[i]) : frame[reads[i]]);
         h = add(h, key[i]);
     }
     return settle(q, h, key, std::integral_constant<uint32_t, N>(), e);
+}
+
+// A key of N slots (no clock or frame).
+template <uint32_t N>
+bool probeSlots(const Probe& q, const uint32_t* reads, const double* frame, uint64_t*& e) {
+    return probeKey<0, N>(Time{}, q, reads, frame, e);
 }
 
 using ProbeSlots = bool (*)(const Probe&, const uint32_t*, const double*, uint64_t*&);
@@ -231,17 +239,15 @@ constexpr std::array<ProbeSlots, sizeof...(N)> probesFor(std::integer_sequence<u
 constexpr auto kProbeSlots =
     probesFor(std::make_integer_sequence<uint32_t, StepMemoPlan::kMaxReads + 1>());
 
-// A key that reads clock or frame (first) and then slots; out of lookup()'s way.
-[[gnu::noinline]] bool probeWithTime(const Graph& g, const Probe& q, const uint32_t* reads,
-                                     uint32_t count, const double* frame, uint64_t*& e) {
-    uint64_t key[StepMemoPlan::kMaxReads];
-    uint64_t h = add(0, q.node);
-    for (uint32_t i = 0; i < count; ++i) {
-        key[i] = bits(readValue(g, reads[i], frame));
-        h = add(h, key[i]);
-    }
-    return settle(q, h, key, count, e);
+// Keys that read the time once or twice (clock, frame or both): [T - 1][N], none for N < T.
+using ProbeTimed = bool (*)(const Time&, const Probe&, const uint32_t*, const double*, uint64_t*&);
+template <uint32_t T, uint32_t... N>
+constexpr std::array<ProbeTimed, sizeof...(N)> timedFor(std::integer_sequence<uint32_t, N...>) {
+    return {(N < T ? nullptr : probeKey<T, (N < T ? T : N)>)...};
 }
+constexpr std::array<std::array<ProbeTimed, StepMemoPlan::kMaxReads + 1>, 2> kProbeTimed{
+    timedFor<1>(std::make_integer_sequence<uint32_t, StepMemoPlan::kMaxReads + 1>()),
+    timedFor<2>(std::make_integer_sequence<uint32_t, StepMemoPlan::kMaxReads + 1>())};
 
 }  // namespace
 
@@ -250,9 +256,12 @@ bool StepMemo::lookup(NodeId n, const StepMemoPlan::NodePlan& p, EvalState in, u
     if (hits_ + misses_ == windowEnd_) endWindow();
     const uint32_t* reads = plan_.reads(p);
     const Probe q{n, p.usesPath ? in.path : 0, p.usesPath, table_.data(), mask_, stride_};
-    const bool found = p.readCount == 0 || reads[0] < StepMemoPlan::kFrame
-                           ? kProbeSlots[p.readCount](q, reads, in.frame, e)
-                           : probeWithTime(g_, q, reads, p.readCount, in.frame, e);
+    bool found;
+    if (p.readCount == 0 || reads[0] < StepMemoPlan::kFrame) [[likely]]
+        found = kProbeSlots[p.readCount](q, reads, in.frame, e);
+    else  // the time's reads come first: a second one is the other of clock and frame
+        found = kProbeTimed[p.readCount > 1 && reads[1] >= StepMemoPlan::kFrame][p.readCount](
+            g_.time, q, reads, in.frame, e);
     ++(found ? hits_ : misses_);
     return found;
 }

@@ -112,12 +112,51 @@ std::string keysOfEveryLength() {
     return text + "sphere\n";
 }
 
-// A key's value changed: slot r of the frame, or the clock.
+// C-nodes that read the time (`frame`, or `clock` and `frame`) and then 0 to 14 slots: every
+// length of the keys the lookup unrolls for them.
+std::string timedKeysOfEveryLength() {
+    std::string text = "{", sum;
+    for (int i = 1; i <= 14; ++i)
+        text += "s" + std::to_string(i) + " = " + std::to_string(i) + "; ";
+    text += "r = 0} {r = frame} {r = clock + frame} ";
+    for (int k = 1; k <= 14; ++k) {
+        sum += " + s" + std::to_string(k);
+        text += "{r = frame" + sum + "} {r = clock + frame" + sum + "} ";
+    }
+    return text + "sphere\n";
+}
+
+// A key's value changed: slot r of the frame, the clock or the frame number.
 void change(Graph& g, std::vector<double>& frame, uint32_t r, double v) {
     if (r == StepMemoPlan::kClock)
         g.time.clock = v;
+    else if (r == StepMemoPlan::kFrame)
+        g.time.frame = static_cast<int>(v);
     else
         frame[r] = v;
+}
+
+// Node n's key, in a one-entry table: the same values again hit, each value changed alone
+// misses and gives the computed values.
+void expectEachValueMisses(Graph& g, const StepMemoPlan& plan, NodeId n) {
+    const StepMemoPlan::NodePlan& p = plan.of(n);
+    StepMemo memo(g, plan, 0);  // one entry: each lookup meets the key before it
+    std::vector<double> frame(g.slotCount(), 1.0), direct(g.slotCount()), got(g.slotCount());
+    g.time.clock = 1;
+    g.time.frame = 1;
+    const EvalState s{frame.data(), kRootPath};
+    memo.calc(n, s, got.data());
+    memo.calc(n, s, got.data());
+    for (uint32_t j = 0; j < p.readCount; ++j) {  // each value alone differs: a miss
+        change(g, frame, plan.reads(p)[j], 2);
+        memo.calc(n, s, got.data());
+        applyCalc(g, n, s, direct.data());
+        ASSERT_TRUE(sameBits(direct.data(), got.data(), got.size())) << "value " << j;
+        change(g, frame, plan.reads(p)[j], 1);
+        memo.calc(n, s, got.data());
+    }
+    EXPECT_EQ(memo.hits(), 1u) << "node " << n << ", " << p.readCount << " values";
+    EXPECT_EQ(memo.misses(), 1u + 2 * p.readCount) << "node " << n;
 }
 
 TEST(StepMemo, KeysOfEveryLengthHitOnlyWhenEveryValueIsTheSame) {
@@ -130,24 +169,28 @@ TEST(StepMemo, KeysOfEveryLengthHitOnlyWhenEveryValueIsTheSame) {
         const StepMemoPlan::NodePlan& p = plan.of(n);
         if (g.nodes[n].kind != NodeKind::Calc || !p.memoised) continue;
         lengths |= 1u << p.readCount;
-        StepMemo memo(g, plan, 0);  // one entry: each lookup meets the key before it
-        std::vector<double> frame(g.slotCount(), 1.0), direct(g.slotCount()), got(g.slotCount());
-        g.time.clock = 1;
-        const EvalState s{frame.data(), kRootPath};
-        memo.calc(n, s, got.data());
-        memo.calc(n, s, got.data());
-        for (uint32_t j = 0; j < p.readCount; ++j) {  // each value alone differs: a miss
-            change(g, frame, plan.reads(p)[j], 2);
-            memo.calc(n, s, got.data());
-            applyCalc(g, n, s, direct.data());
-            ASSERT_TRUE(sameBits(direct.data(), got.data(), got.size())) << "value " << j;
-            change(g, frame, plan.reads(p)[j], 1);
-            memo.calc(n, s, got.data());
-        }
-        EXPECT_EQ(memo.hits(), 1u) << "node " << n << ", " << p.readCount << " values";
-        EXPECT_EQ(memo.misses(), 1u + 2 * p.readCount) << "node " << n;
+        expectEachValueMisses(g, plan, n);
     }
     EXPECT_EQ(lengths & 0x1fffeu, 0x1fffeu) << "keys of 1 to 16 values";
+}
+
+TEST(StepMemo, KeysThatReadTheTimeHitOnlyWhenEveryValueIsTheSame) {
+    auto c = testing::compileUnfolded(timedKeysOfEveryLength());
+    ASSERT_TRUE(c->graph) << c->errors();
+    Graph& g = *c->graph;
+    const StepMemoPlan plan(g);
+    uint32_t frameOnly = 0, both = 0;  // the key lengths seen, as bits
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        const StepMemoPlan::NodePlan& p = plan.of(n);
+        if (g.nodes[n].kind != NodeKind::Calc || !p.memoised || p.readCount == 0) continue;
+        const uint32_t* reads = plan.reads(p);
+        if (reads[0] < StepMemoPlan::kFrame) continue;  // the first C-node: slots only
+        const bool twice = p.readCount > 1 && reads[1] >= StepMemoPlan::kFrame;
+        (twice ? both : frameOnly) |= 1u << p.readCount;
+        expectEachValueMisses(g, plan, n);
+    }
+    EXPECT_EQ(frameOnly, 0xfffeu) << "frame and 0 to 14 slots";
+    EXPECT_EQ(both, 0x1fffcu) << "clock, frame and 0 to 14 slots";
 }
 
 TEST(StepMemo, TheInstancePathIsPartOfTheKeyOnlyForRandomSteps) {
