@@ -304,6 +304,54 @@ class InstanceBoxes::CountingWorker : public WorkerOf<BoxSinkOf<CountedBoxResult
 
 // ---------------------------------------------------------------------------------------
 
+namespace {
+// The modules' dependencies, with the key slots narrowed to the parameters that tell
+// their instances apart.
+std::vector<ModuleDependencies> narrowedDependencies(const Graph& g, const FixedSlots& fixed) {
+    std::vector<ModuleDependencies> deps = moduleDependencies(g);
+    narrowKeySlots(g, fixed, deps);
+    return deps;
+}
+}  // namespace
+
+InstanceKeys::InstanceKeys(const Graph& g, const std::vector<ModuleDependencies>& deps)
+    : plans_(g.nodes.size()) {
+    for (NodeId n = 0; n < g.nodes.size(); ++n) {
+        if (g.nodes[n].kind != NodeKind::Select) continue;
+        const ModuleDependencies& d = deps[g.nodes[n].payload];
+        plans_[n] = Plan{static_cast<uint32_t>(slots_.size()),
+                         static_cast<uint32_t>(d.reads.size()), d.usesPath};
+        slots_.insert(slots_.end(), d.reads.begin(), d.reads.end());
+    }
+}
+
+// Two lanes of xxHash64's round (acc = rotl(acc + v * P2, 31) * P1), each with its own
+// constants, finished with SplitMix64's finaliser: one multiplication per value on each
+// lane's dependency chain, where a full finaliser per value took three. The node's slots
+// come from its plan (no look-up of its module's dependencies), two per loop: the same
+// keys as hashing them one by one.
+InstanceKeys::Key InstanceKeys::of(NodeId select, const double* frame, uint64_t path) const {
+    constexpr uint64_t P1 = 0x9e3779b185ebca87ULL, P2 = 0xc2b2ae3d27d4eb4fULL;
+    constexpr uint64_t P3 = 0x165667b19e3779f9ULL, P4 = 0x85ebca77c2b2ae63ULL;
+    const Plan& p = plans_[select];
+    uint64_t a = 0x84222325cbf29ce4ULL ^ (select * P1), b = 0x2545f4914f6cdd1dULL + select * P3;
+    auto round = [&](uint64_t v) {
+        a = std::rotl(a + v * P2, 31) * P1;
+        b = std::rotl(b + v * P4, 29) * P3;
+    };
+    const Slot* s = slots_.data() + p.first;
+    uint32_t left = p.count;
+    for (; left >= 2; left -= 2, s += 2) {
+        round(std::bit_cast<uint64_t>(frame[s[0]]));
+        round(std::bit_cast<uint64_t>(frame[s[1]]));
+    }
+    if (left) round(std::bit_cast<uint64_t>(frame[*s]));
+    if (p.usesPath) round(path);
+    a = mix(a ^ (p.count + (p.usesPath ? 1 : 0)));
+    b = mix(b ^ std::rotl(a, 32));
+    return {a | 1, b};  // a != 0: never the empty slot
+}
+
 InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
                              const InstanceBoxOptions& options)
     : InstanceBoxes(g, bounds, options, FixedSlots(g)) {}
@@ -314,14 +362,14 @@ InstanceBoxes::InstanceBoxes(const Graph& g, const Bounds& bounds,
       sem_(g),
       bounds_(bounds),
       opt_(options),
-      deps_(moduleDependencies(g)),
+      deps_(narrowedDependencies(g, fixed)),
+      keys_(g, deps_),
       table_(std::make_unique<Table>(options.maxBytes)),
       sequence_(options.sequence),
       lasting_(g.modules.size(), 0),
       levels_(g.scene.settings.maxDepth + 2) {
     if (sequence_ && &sequence_->g_ != &g)
         throw std::logic_error("InstanceBoxes: the sequence's boxes belong to another graph");
-    narrowKeySlots(g, fixed, deps_);  // keys hash only the parameters that tell instances apart
     for (size_t m = 0; m < lasting_.size() && sequence_; ++m)
         lasting_[m] = deps_[m].analysed && !deps_[m].usesTime;
     const size_t n = g.modules.size() * static_cast<size_t>(levels_);
@@ -372,33 +420,6 @@ uint64_t InstanceBoxes::unrollWeight(NodeId select, uint32_t depth) const {
     if (depth >= levels_) return 0;
     const size_t i = levelIndex(select, depth);
     return maxWeight_[i].load(std::memory_order_relaxed);
-}
-
-// Two lanes of xxHash64's round (acc = rotl(acc + v * P2, 31) * P1), each with its own
-// constants, finished with SplitMix64's finaliser: one multiplication per value on each
-// lane's dependency chain, where a full finaliser per value took three.
-namespace {
-InstanceBoxes::Key instanceKey(const Graph& g, const std::vector<ModuleDependencies>& deps,
-                               NodeId select, const double* frame, uint64_t path) {
-    constexpr uint64_t P1 = 0x9e3779b185ebca87ULL, P2 = 0xc2b2ae3d27d4eb4fULL;
-    constexpr uint64_t P3 = 0x165667b19e3779f9ULL, P4 = 0x85ebca77c2b2ae63ULL;
-    const ModuleDependencies& d = deps[g.nodes[select].payload];
-    uint64_t a = 0x84222325cbf29ce4ULL ^ (select * P1), b = 0x2545f4914f6cdd1dULL + select * P3;
-    auto round = [&](uint64_t v) {
-        a = std::rotl(a + v * P2, 31) * P1;
-        b = std::rotl(b + v * P4, 29) * P3;
-    };
-    for (Slot s : d.reads) round(std::bit_cast<uint64_t>(frame[s]));
-    if (d.usesPath) round(path);
-    const uint64_t n = d.reads.size() + (d.usesPath ? 1 : 0);
-    a = mix(a ^ n);
-    b = mix(b ^ std::rotl(a, 32));
-    return {a | 1, b};  // a != 0: never the empty slot
-}
-}  // namespace
-
-InstanceBoxes::Key InstanceBoxes::keyOf(NodeId select, const double* frame, uint64_t path) const {
-    return instanceKey(g_, deps_, select, frame, path);
 }
 
 InstanceBoxes::Table& InstanceBoxes::tableOf(NodeId select) const {
@@ -575,8 +596,7 @@ namespace {
 // KnownCounts for countExpansion): found by their keys, at the one depth of the seeds.
 class PrefillCounts : public KnownCounts {
   public:
-    PrefillCounts(const Graph& g, std::vector<ModuleDependencies> deps, uint32_t depth)
-        : g_(g), deps_(std::move(deps)), depth_(depth) {}
+    PrefillCounts(const InstanceKeys& keys, uint32_t depth) : keys_(keys), depth_(depth) {}
 
     void add(const InstanceBoxes::Key& k, const KnownSubtree& s) { known_.emplace(k, s); }
     bool empty() const { return known_.empty(); }
@@ -584,7 +604,7 @@ class PrefillCounts : public KnownCounts {
     bool find(NodeId select, uint32_t depth, const double* frame, uint64_t path,
               KnownSubtree& out) const override {
         if (depth + 1 != depth_) return false;
-        const auto it = known_.find(instanceKey(g_, deps_, select, frame, path));
+        const auto it = known_.find(keys_.of(select, frame, path));
         if (it == known_.end()) return false;
         out = it->second;
         return true;
@@ -594,8 +614,7 @@ class PrefillCounts : public KnownCounts {
     struct KeyHash {
         size_t operator()(const InstanceBoxes::Key& k) const { return static_cast<size_t>(k.b); }
     };
-    const Graph& g_;
-    const std::vector<ModuleDependencies> deps_;
+    const InstanceKeys keys_;
     const uint32_t depth_;  // the seeds' (S-nodes passed, this one included)
     std::unordered_map<InstanceBoxes::Key, KnownSubtree, KeyHash> known_;
 };
@@ -623,7 +642,7 @@ std::shared_ptr<const KnownCounts> InstanceBoxes::prefill(NodeId start,
             stop = true;
         }
     });
-    auto known = std::make_shared<PrefillCounts>(g_, deps_, seeds.front().depth);
+    auto known = std::make_shared<PrefillCounts>(keys_, seeds.front().depth);
     for (size_t i = 0; i < seeds.size(); ++i)
         if (counted[i] && seeds[i].depth == seeds.front().depth)
             known->add(keyOf(seeds[i].node, seeds[i].frame.data(), seeds[i].path), *counted[i]);

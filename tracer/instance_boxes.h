@@ -56,6 +56,30 @@ namespace pcsg::tracer {
 
 class SequenceInstanceBoxes;
 
+// The keys of S-node instances: an instance is its S-node, the values of the parameters
+// its sub-graph reads (ModuleDependencies::reads, as narrowKeySlots leaves them) and, when
+// it calls rand() or choose(), its instance path, hashed to 128 bits. The walk makes one
+// per S-node visit at a used depth, so the slots to hash are laid out per node, in one
+// array, rather than found through the node's module and its dependencies each time.
+class InstanceKeys {
+  public:
+    struct Key {
+        uint64_t a = 0, b = 0;
+        bool operator==(const Key&) const = default;
+    };
+    InstanceKeys(const Graph& g, const std::vector<ModuleDependencies>& deps);
+    Key of(NodeId select, const double* frame, uint64_t path) const;
+
+  private:
+    struct Plan {
+        uint32_t first = 0;  // the node's slots are slots_[first, first + count)
+        uint32_t count = 0;
+        bool usesPath = false;
+    };
+    std::vector<Plan> plans_;  // per node (S-nodes only)
+    std::vector<Slot> slots_;
+};
+
 struct InstanceBoxOptions {
     size_t maxBytes = 64u << 20;  // the table's size limit
     // Store instances whose unrolling took this many visits (the terrain: its instances
@@ -113,11 +137,10 @@ class InstanceBoxes {
 
     // An instance: its S-node, the values of the parameters its sub-graph reads and, when
     // it calls rand() or choose(), its instance path, hashed to 128 bits.
-    struct Key {
-        uint64_t a = 0, b = 0;
-        bool operator==(const Key&) const = default;
-    };
-    Key keyOf(NodeId select, const double* frame, uint64_t path) const;
+    using Key = InstanceKeys::Key;
+    Key keyOf(NodeId select, const double* frame, uint64_t path) const {
+        return keys_.of(select, frame, path);
+    }
 
     // What a thread needs to unroll instances (the walk's stacks): one per thread.
     class Worker;
@@ -190,6 +213,7 @@ class InstanceBoxes {
     const Bounds& bounds_;
     InstanceBoxOptions opt_;
     std::vector<ModuleDependencies> deps_;
+    InstanceKeys keys_;  // after deps_: made from them, narrowed
     std::unique_ptr<Table> table_;
     std::shared_ptr<SequenceInstanceBoxes> sequence_;
     std::vector<uint8_t> lasting_;  // per module: its boxes go to the sequence's table

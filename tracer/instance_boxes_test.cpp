@@ -11,6 +11,7 @@
 #include <random>
 
 #include "expander.h"
+#include "key_slots.h"
 #include "outward_float.h"
 #include "primitives.h"
 #include "test_support.h"
@@ -513,6 +514,53 @@ TEST(InstanceBoxes, BoxesRoundToTheFloatsNextafterGives) {
         EXPECT_EQ(std::bit_cast<uint32_t>(castDown(x)), std::bit_cast<uint32_t>(down)) << x;
         EXPECT_EQ(std::bit_cast<uint32_t>(castUp(x)), std::bit_cast<uint32_t>(up)) << x;
     }
+}
+
+// The keys of instance_boxes.h's InstanceKeys: equal exactly when the instances are the
+// same (the same S-node, the same values in the slots narrowKeySlots keeps and, where the
+// module uses it, the same path). Modules that hash an odd and an even number of slots.
+TEST(InstanceKeys, TwoInstancesHaveTheSameKeyExactlyWhenTheyAreTheSameInstance) {
+    // S hashes n, a, b; P n, b and its path; Q n, a.
+    auto c = compile(
+        "{ a = 1; b = 2; n = 3 } S ∪ { a = 1; b = 2; n = 3 } P ∪ { a = 1; n = 3 } Q\n"
+        "S if(n > 0, 1, 2)\n"
+        "1: S -> { n = n - 1; a = a + b; b = b * 0.5 } move(a, b, 0) S\n"
+        "2: S -> sphere\n"
+        "P if(n > 0, 1, 2)\n"
+        "1: P -> { n = n - 1; b = b * 0.5 } move(b, rand(), 0) P\n"
+        "2: P -> sphere\n"
+        "Q if(n > 0, 1, 2)\n"
+        "1: Q -> { n = n - 1; a = a * 0.5 } move(a, 0, 0) Q\n"
+        "2: Q -> sphere\n");
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    std::vector<ModuleDependencies> deps = moduleDependencies(g);
+    narrowKeySlots(g, FixedSlots(g), deps);
+    const InstanceKeys keys(g, deps);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> value(-4, 4);
+    std::vector<double> frame(g.slotCount());
+    for (double& v : frame) v = value(rng);
+    std::vector<InstanceKeys::Key> seen;
+    bool odd = false, even = false, path = false;
+    for (const Module& m : g.modules) {
+        const ModuleDependencies& d = deps[g.nodes[m.node].payload];
+        (d.reads.size() % 2 ? odd : even) |= d.reads.size() >= 2;
+        path |= d.usesPath;
+        const InstanceKeys::Key k = keys.of(m.node, frame.data(), 5);
+        for (const InstanceKeys::Key& other : seen) EXPECT_FALSE(k == other) << m.name;
+        seen.push_back(k);
+        std::vector<double> same = frame;  // a copy: the key reads values, not addresses
+        EXPECT_EQ(keys.of(m.node, same.data(), 5), k) << m.name;
+        for (Slot s = 0; s < frame.size(); ++s) {
+            std::vector<double> changed = frame;
+            changed[s] += 0.5;
+            const bool read = std::find(d.reads.begin(), d.reads.end(), s) != d.reads.end();
+            EXPECT_EQ(keys.of(m.node, changed.data(), 5) == k, !read) << m.name << " slot " << s;
+        }
+        EXPECT_EQ(keys.of(m.node, frame.data(), 6) == k, !d.usesPath) << m.name;
+    }
+    EXPECT_TRUE(odd && even && path);  // the loop's pairs, its last odd slot, the path
 }
 
 }  // namespace
