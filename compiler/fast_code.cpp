@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <utility>
 #include <vector>
 
 namespace pcsg {
@@ -211,23 +212,34 @@ uint32_t translateExpr(Graph& g, const Expr& e) {
     return start;
 }
 
-// In order (not simultaneous), the frame the values read is the one they are stored in:
-// an assignment that starts by reading the slot the one before stored keeps it in acc.
-uint32_t translateCalc(Graph& g, const Calc& c) {
+// A program that stores values: the expression of assignment i to its slot, for i < count,
+// then End; none (nothing left in fastCode) where the machine cannot run one of them.
+// `chained`: each expression reads the frame the one before stored into, so one that starts
+// by reading that slot keeps it in acc.
+template <class AssignmentAt>
+uint32_t translateStores(Graph& g, uint32_t count, bool chained, AssignmentAt assignmentAt) {
     const auto start = static_cast<uint32_t>(g.fastCode.size());
     Slot held = kNone;
-    for (uint32_t i = 0; i < c.count; ++i) {
-        const Assignment& as = g.assignments[c.first + i];
-        const Expr& e = g.exprs[as.value];
+    for (uint32_t i = 0; i < count; ++i) {
+        const auto [value, slot] = assignmentAt(i);
+        const Expr& e = g.exprs[value];
         if (!translate(g, e.begin, e.end, held)) {
             g.fastCode.resize(start);
             return kNoFast;
         }
-        g.fastCode.push_back(FastInstr{FastOp::Store, 0, 0, as.slot});
-        held = c.simultaneous ? kNone : as.slot;
+        g.fastCode.push_back(FastInstr{FastOp::Store, 0, 0, slot});
+        held = chained ? slot : kNone;
     }
     g.fastCode.push_back(FastInstr{FastOp::End});
     return start;
+}
+
+// In order (not simultaneous), the frame the values read is the one they are stored in.
+uint32_t translateCalc(Graph& g, const Calc& c) {
+    return translateStores(g, c.count, !c.simultaneous, [&](uint32_t i) {
+        const Assignment& as = g.assignments[c.first + i];
+        return std::pair<ExprId, Slot>{as.value, as.slot};
+    });
 }
 
 // A lone constant or parameter: evalExpr() reads it without the machine.
@@ -244,17 +256,9 @@ uint32_t translateArgs(Graph& g, const Transform& t) {
     bool leavesOnly = true;
     for (uint32_t i = 0; i < t.argCount; ++i) leavesOnly &= loneLeaf(g, g.args[t.firstArg + i]);
     if (leavesOnly) return kNoFast;
-    const auto start = static_cast<uint32_t>(g.fastCode.size());
-    for (uint32_t i = 0; i < t.argCount; ++i) {
-        const Expr& e = g.exprs[g.args[t.firstArg + i]];
-        if (!translate(g, e.begin, e.end)) {
-            g.fastCode.resize(start);
-            return kNoFast;
-        }
-        g.fastCode.push_back(FastInstr{FastOp::Store, 0, 0, i});
-    }
-    g.fastCode.push_back(FastInstr{FastOp::End});
-    return start;
+    return translateStores(g, t.argCount, false, [&](uint32_t i) {
+        return std::pair<ExprId, Slot>{g.args[t.firstArg + i], i};
+    });
 }
 
 #define PCSG_FAST_NAME(name) #name,

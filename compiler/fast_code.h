@@ -1,11 +1,10 @@
-// The peephole pass that gives a graph's expressions and C-nodes their fast form
-// (fast_instr.h), and its text for tests and debugging.
+// The peephole pass that gives a graph's expressions, C-nodes and T-nodes' arguments their
+// fast form (fast_instr.h), and its text for tests and debugging.
 //
 // The pass reads Graph::code and writes Graph::fastCode, Expr::fast, Calc::fast and
-// Transform::fast. A pass
-// that changes Graph::code afterwards must call dropFastCode() first (or build again):
-// until then evaluation would follow the old code. The compiler builds the fast form last
-// (compileSource); graphs made by hand have none and run the plain code.
+// Transform::fast. A pass that changes Graph::code afterwards must call dropFastCode() first
+// (or build again): until then evaluation would follow the old code. The compiler builds the
+// fast form last (compileSource); graphs made by hand have none and run the plain code.
 #pragma once
 
 #include <string>
