@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <set>
 
@@ -66,17 +65,13 @@ TEST(Expander, SierpinskiCornersAreTheTetrahedronsVertices) {
 }
 
 TEST(Expander, CountingIsMemoisedForDeterministicSystems) {
-    const auto start = std::chrono::steady_clock::now();
     const ExpansionCount c = countExpansion(sierpinski(12));
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_TRUE(c.complete);
     EXPECT_EQ(c.primitives, pow4(12));
     EXPECT_EQ(c.nodes, pow4(12) + (pow4(12) - 1) / 3);
     // Each (S, c) pair is visited through its four corners once: a few hundred visits,
     // where the unmemoised walk would make tens of millions.
     EXPECT_LT(c.visits, 1000u);
-    EXPECT_LT(seconds, 5.0);  // generous: only catches a lost memoisation
     // Order 40 saturates instead of overflowing.
     const ExpansionCount big = countExpansion(sierpinski(40));
     EXPECT_TRUE(big.complete);
