@@ -7,6 +7,7 @@
 #include <cstring>
 #include <exception>
 #include <limits>
+#include <type_traits>
 
 #include "bounds.h"
 #include "bvh_slabs.h"
@@ -673,6 +674,60 @@ std::vector<std::vector<uint32_t>> UnrolledInstance::bvhLeafGroups() const {
 size_t UnrolledInstance::looseOperands() const {
     return static_cast<size_t>(
         std::count_if(nodes_.begin(), nodes_.end(), [](const Node& n) { return n.looseInBvh; }));
+}
+
+namespace {
+
+// FNV-1a over the bytes of values without padding.
+struct Digest {
+    uint64_t h = 0xcbf29ce484222325ULL;
+    template <class T>
+    void add(const T& v) {
+        static_assert(std::has_unique_object_representations_v<T> || std::is_floating_point_v<T>);
+        unsigned char bytes[sizeof(T)];
+        std::memcpy(bytes, &v, sizeof v);
+        for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ULL;
+    }
+    template <class T>
+    void addAll(const std::vector<T>& v) {
+        add(v.size());
+        for (const T& x : v) add(x);
+    }
+};
+
+}  // namespace
+
+uint64_t UnrolledInstance::digest() const {
+    Digest d;
+    d.add(nodes_.size());
+    for (const Node& n : nodes_) {
+        d.add(static_cast<uint32_t>(n.kind) | static_cast<uint32_t>(n.op) << 8 |
+              static_cast<uint32_t>(n.prim) << 16 | static_cast<uint32_t>(n.looseInBvh) << 24);
+        for (uint32_t v : {n.material, n.firstMatrix, n.matrices, n.first, n.count, n.firstChoice,
+                           n.choices, n.bvh})
+            d.add(v);
+        for (int a = 0; a < 3; ++a) d.add(n.box.lo[a]), d.add(n.box.hi[a]);
+    }
+    d.addAll(children_);
+    d.add(matrices_.size());
+    for (const Affine& m : matrices_) {
+        for (const auto& row : m.l)
+            for (double v : row) d.add(v);
+        for (int a = 0; a < 3; ++a) d.add(m.t[a]);
+    }
+    d.addAll(matrixRefs_);
+    d.addAll(args_);
+    d.addAll(choices_);
+    d.add(bvh_.size());
+    for (const BvhNode& b : bvh_)
+        for (int k = 0; k < 4; ++k) {
+            for (int a = 0; a < 3; ++a) d.add(b.lo[a][k]), d.add(b.hi[a][k]);
+            d.add(b.child[k]), d.add(b.link[k]);
+        }
+    d.add(links_.size());
+    for (const Link& l : links_) d.add(l.parent), d.add(l.matrix);
+    for (uint32_t v : {root_, rootBvh_, levels_, bvhLeaves_, linkSlots_}) d.add(v);
+    return d.h;
 }
 
 LocalRay UnrolledInstance::enter(const Node& node, const LocalRay& r) const {

@@ -171,6 +171,10 @@ class UnrolledInstance {
     std::vector<std::vector<uint32_t>> bvhLeafGroups() const;
     // The operands whose own box is tested before they are entered (Node::looseInBvh).
     size_t looseOperands() const;
+    // A hash of the expansion's arrays, field by field (nodes, children, matrices and their
+    // references, arguments, choices, hierarchy, links): expansions built by different code
+    // compare equal only when they hold the same values bit for bit (tests).
+    uint64_t digest() const;
 
   private:
     friend class Unroller;

@@ -462,5 +462,37 @@ TEST(ExpandedInstances, OperandsBelowRotationsTestTheirOwnBoxes) {
     EXPECT_EQ(straight->looseOperands(), 0u);
 }
 
+// A terrain patch in small (scenes/terrain.pcsg's shape without its random numbers): four
+// operands a level, each through a constant scale and move, and per triangle the two
+// parameter T-nodes move(0,0,z1) zshear(...) whose inverses the expansion stores once each.
+const char* kPatch = R"(
+{n = 3; z1 = 0; z2 = 0.5; z3 = 0.25; k = 1} T
+T if(n > 0, 2, 1)
+1: T -> move(0,0,z1) zshear(z2-z1,z3-z1) tri1
+2: T -> {n = n-1; k = k/2} (
+        {z2 = (z1+z2)/2; z3 = (z1+z3)/2 + k/8} scale(0.5,0.5,1) T ∪
+        {z1 = (z1+z2)/2 - k/16; z3 = (z2+z3)/2} move(0.5,0,0) scale(0.5,0.5,1) T ∪
+        {z1 = (z1+z3)/2; z2 = (z2+z3)/2 + k/4} move(0,0.5,0) scale(0.5,0.5,1) T ∪
+        {z1 = (z2+z3)/2; z2 = z3 - k/8; z3 = z2 + k/16} move(0.5,0.5,0) rotz(180) scale(0.5,0.5,1) T)
+)";
+
+// What an expansion builds, its arrays bit for bit, as the unroller of main at 7577474
+// built them (the hashes below are of its expansions): a change that makes a build cheaper
+// must leave them all the same (nodes and boxes, matrices stored once in the same order,
+// their references, the hierarchy's float boxes and links).
+TEST(ExpandedInstances, ExpansionsHoldWhatTheUnrollerBuiltBefore) {
+    const auto patch = expandAxiom(kPatch);
+    ASSERT_TRUE(patch);
+    EXPECT_EQ(patch->bvhNodes(), 64u + 21u);
+    EXPECT_EQ(patch->digest(), 6458956179079065779u);
+    const auto chains = expandAxiom(kDeepChains);
+    ASSERT_TRUE(chains);
+    EXPECT_EQ(chains->digest(), 12547906493058260917u);
+    const auto sierpinski = expandAxiom(testing::kSierpinski);
+    ASSERT_TRUE(sierpinski);
+    EXPECT_EQ(sierpinski->digest(), 2105740141657389315u);
+    EXPECT_GT(compareWithGraphWalk(kPatch, 1.0, 100), 0u);
+}
+
 }  // namespace
 }  // namespace pcsg::tracer
