@@ -96,6 +96,14 @@ union SpanRoom {
     Span s[kMaxPrimitiveSpans];
 };
 
+// Room for a forward map's product, left unwritten until the product is (an Affine starts
+// as the identity: nine stores at each of the unroller's steps, most of which multiply
+// nothing). Affine is trivially copyable: assigning the member begins its lifetime.
+union AffineRoom {
+    AffineRoom() {}
+    Affine m;
+};
+
 }  // namespace
 
 class Unroller {
@@ -267,10 +275,11 @@ class Unroller {
         }
         if (st.inverse) pending_.push_back(inverseIndex(n, *st.inverse));
         // (from the identity: the step's own matrix where that is exact, Semantics' rule)
-        Affine composed;
+        AffineRoom composed;
         const Affine* next = edge;
         if (st.forward)
-            next = edge ? &(composed = *edge * *st.forward) : &sem_.fromIdentity(n, st, composed);
+            next =
+                edge ? &(composed.m = *edge * *st.forward) : &sem_.fromIdentity(n, st, composed.m);
         const uint32_t r = build(st.child, st.state, pendingBase, next);
         if (st.inverse) pending_.pop_back();
         if (kind == NodeKind::Select) choices_.pop_back();
@@ -374,10 +383,12 @@ class Unroller {
     // bits: the nodes that use it apply the very numbers the walk would).
     uint32_t matrixIndex(const Affine& m) {
         static_assert(sizeof(Affine) == 12 * sizeof(double));
-        uint64_t words[12];
-        std::memcpy(words, &m, sizeof words);
+        // (the twelve words in their order in memory, read in place: no copy to the stack)
         uint64_t h = 0x9e3779b97f4a7c15ULL;
-        for (uint64_t w : words) h = (h ^ w) * 0xff51afd7ed558ccdULL;
+        for (const auto& row : m.l)
+            for (double v : row) h = (h ^ std::bit_cast<uint64_t>(v)) * 0xff51afd7ed558ccdULL;
+        for (int a = 0; a < 3; ++a)
+            h = (h ^ std::bit_cast<uint64_t>(m.t[a])) * 0xff51afd7ed558ccdULL;
         const auto [at, inserted] =
             matrixIndex_.tryEmplace(h, static_cast<uint32_t>(out_.matrices_.size()));
         if (!inserted && std::memcmp(&out_.matrices_[at], &m, sizeof m) == 0) return at;
@@ -627,10 +638,13 @@ class Unroller {
     uint64_t visits_ = 0;
     uint32_t base_ = 0;
     // Parameter frames, a stack (addresses stay valid while deeper ones are pushed).
+    // (The allocation out of line: a C-step then takes the frame inline.)
     double* pushFrame() {
-        if (framesUsed_ == frames_.size())
-            frames_.push_back(std::make_unique<double[]>(std::max<size_t>(g_.slotCount(), 1)));
+        if (framesUsed_ == frames_.size()) addFrame();
         return frames_[framesUsed_++].get();
+    }
+    [[gnu::noinline]] void addFrame() {
+        frames_.push_back(std::make_unique<double[]>(std::max<size_t>(g_.slotCount(), 1)));
     }
     std::vector<std::unique_ptr<double[]>> frames_;
     size_t framesUsed_ = 0;
