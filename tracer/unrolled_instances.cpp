@@ -444,7 +444,7 @@ class Unroller {
                 Affine to = toU;
                 for (uint32_t k = 0; k < child.matrices; ++k) {
                     l = linkTo(l, out_.matrixRefs_[child.firstMatrix + k]);
-                    to = to * out_.matrices_[out_.matrixRefs_[child.firstMatrix + k]].inverse();
+                    to = to * inverseOf(out_.matrixRefs_[child.firstMatrix + k]);
                 }
                 const Part inner = collect(c, to, l, length + child.matrices, items);
                 if (inner.child != kNone) parts_.push_back(inner);
@@ -461,6 +461,14 @@ class Unroller {
         return whole;
     }
 
+    // out_.matrices_[matrix].inverse(), computed once per matrix met (the unions of a
+    // terrain patch enter their operands through the same few constant matrices).
+    const Affine& inverseOf(uint32_t matrix) {
+        InverseSlot& s = inverses_[matrix % kInverseSlots];
+        if (s.matrix != matrix) s = {matrix, out_.matrices_[matrix].inverse()};
+        return s.inverse;
+    }
+
     // Whether m maps boxes to boxes (each row of its linear part has at most one nonzero
     // entry): else the box of a mapped box is larger than what it holds.
     static bool scaledPermutation(const Affine& m) {
@@ -473,18 +481,21 @@ class Unroller {
     Part pairUp(size_t begin, size_t end) {
         if (begin == end) return Part{};
         if (end - begin == 1) return parts_[begin];
+        if (end - begin == 2) return joined(parts_[begin], parts_[begin + 1]);  // (no copies)
         const size_t mid = begin + (end - begin) / 2;
-        const Part halves[2] = {pairUp(begin, mid), pairUp(mid, end)};
-        Binary b;
-        for (int c = 0; c < 2; ++c) {
-            b.box[c] = halves[c].box;
-            b.child[c] = halves[c].child;
-            b.link[c] = halves[c].link;
-        }
-        binary_.push_back(b);
-        const uint32_t height = 1 + std::max(halves[0].height, halves[1].height);
-        return {static_cast<uint32_t>(binary_.size() - 1), kNone,
-                unite(halves[0].box, halves[1].box), height};
+        const Part first = pairUp(begin, mid);  // (first: its nodes come first in binary_)
+        const Part second = pairUp(mid, end);
+        return joined(first, second);
+    }
+
+    // The binary node over two parts, appended to binary_.
+    Part joined(const Part& a, const Part& b) {
+        Binary x;
+        x.box[0] = a.box, x.child[0] = a.child, x.link[0] = a.link;
+        x.box[1] = b.box, x.child[1] = b.child, x.link[1] = b.link;
+        binary_.push_back(x);
+        return {static_cast<uint32_t>(binary_.size() - 1), kNone, unite(a.box, b.box),
+                1 + std::max(a.height, b.height)};
     }
 
     // The link that applies out_.matrices_[matrix] after the chain `parent`.
@@ -657,6 +668,13 @@ class Unroller {
         uint32_t index = 0;
     };
     ConstIndex constIndex_[kConstIndexSlots];
+    // inverseOf()'s inverses, direct-mapped by matrix index (matrix kNone: a free slot).
+    static constexpr size_t kInverseSlots = 16;
+    struct InverseSlot {
+        uint32_t matrix = kNone;
+        Affine inverse;
+    };
+    InverseSlot inverses_[kInverseSlots];
     std::vector<uint32_t> choices_;
     std::vector<uint32_t> kids_;  // operands of the operators being built
     FlatIndex linkIndex_;         // linkTo()'s links by (parent, matrix)
