@@ -269,16 +269,27 @@ double run(const Graph& g, const Expr& e, EvalState s, double* stack) {
 }  // namespace
 
 namespace {
-// evalExpr(), inlined where a T-node's arguments are read one by one (move(0, 0, z1)).
+// A lone leaf (a T-node's argument `0` or `z1`), read without the machine's set-up, into v:
+// false where e is more than a constant or an assigned parameter.
+[[gnu::always_inline]] inline bool leafOf(const Graph& g, const Expr& e, EvalState s, double& v) {
+    if (e.fast == kNoFast) return false;
+    const FastInstr* f = g.fastCode.data() + e.fast;
+    if (f[1].op != FastOp::End) return false;
+    if (f->op == FastOp::PushK) {
+        v = f->imm;
+        return true;
+    }
+    if (f->op != FastOp::PushL || isUnassigned(s.frame[f->a])) return false;
+    v = s.frame[f->a];
+    return true;
+}
+
+// evalExpr()'s body.
 [[gnu::always_inline]] inline double evalInline(const Graph& g, ExprId id, EvalState s) {
     const Expr& e = g.exprs[id];
     double v;
     if (e.fast != kNoFast) {
-        // A lone leaf (a T-node's argument `0` or `z1`) is read without the machine's set-up.
-        const FastInstr* f = g.fastCode.data() + e.fast;
-        if (f[1].op == FastOp::End && f->op == FastOp::PushK) return f->imm;
-        if (f[1].op == FastOp::End && f->op == FastOp::PushL && !isUnassigned(s.frame[f->a]))
-            return s.frame[f->a];
+        if (leafOf(g, e, s, v)) return v;
         if (runFast(g, e.fast, s.frame, nullptr, s.path, v)) return v;
     }
     constexpr uint32_t kSmall = 64;
@@ -364,11 +375,28 @@ void applyCalc(const Graph& g, NodeId n, EvalState in, double* out) {
     for (uint32_t i = 0; i < c.count; ++i) out[as[i].slot] = values[i];
 }
 
+namespace {
+// move() and zshear(), the terrain's two T-steps a triangle: their matrices are the arguments
+// written into the identity, and their determinant is 1 exactly (see checkedTransform).
+bool isUnitShear(TransformOp op) {
+    return op == TransformOp::Move || op == TransformOp::ZShear;
+}
+// makeTransform() of move() or zshear(), written into `m` (which holds the identity).
+[[gnu::always_inline]] inline void writeUnitShear(TransformOp op, const double* a, Affine& m) {
+    if (op == TransformOp::Move)
+        m.t = {a[0], a[1], a[2]};
+    else
+        m.l[2][0] = a[0], m.l[2][1] = a[1];
+}
+}  // namespace
+
 Affine makeTransform(TransformOp op, const double* a) {
     Affine m;
     switch (op) {
         case TransformOp::Move:
-            return Affine::translate({a[0], a[1], a[2]});
+        case TransformOp::ZShear:
+            writeUnitShear(op, a, m);
+            return m;
         case TransformOp::Scale:
             return Affine::scale({a[0], a[1], a[2]});
         case TransformOp::UScale:
@@ -404,9 +432,6 @@ Affine makeTransform(TransformOp op, const double* a) {
             m.l[2][2] = c + t * k.z * k.z;
             return m;
         }
-        case TransformOp::ZShear:
-            m.l[2][0] = a[0], m.l[2][1] = a[1];
-            return m;
         case TransformOp::FlipYZ:
             m.l[0][0] = -1;
             return m;
@@ -439,13 +464,14 @@ namespace {
 // The values of a T-node's arguments into `a`, each checked finite in order. Its program
 // (Transform::fast) computes each argument as evalExpr() would, all in one run of the
 // machine; where it stops (an unassigned read), the arguments are evaluated one by one,
-// which reports the first error as it always did.
+// which reports the first error as it always did. A lone leaf is read here, anything else
+// through evalExpr() (out of line: the leaves' path keeps a small frame).
 void argumentsOf(const Graph& g, const Transform& t, EvalState s, double* a) {
     double unused;
     const bool all = t.fast != kNoFast && runFast(g, t.fast, s.frame, a, s.path, unused);
     for (uint32_t i = 0; i < t.argCount; ++i) {
         const ExprId id = g.args[t.firstArg + i];
-        if (!all) a[i] = evalInline(g, id, s);
+        if (!all && !leafOf(g, g.exprs[id], s, a[i])) a[i] = evalExpr(g, id, s);
         if (!std::isfinite(a[i]))
             nonFinite(g, g.exprs[id], a[i], "the transformation argument", s.frame);
     }
@@ -453,11 +479,11 @@ void argumentsOf(const Graph& g, const Transform& t, EvalState s, double* a) {
 
 // A T-node's arguments, checked, and its matrix. move() and zshear() of finite arguments
 // have the determinant 1 exactly (its products of the zeros and ones of the identity are
-// exact), so they need no singularity test.
+// exact), so they need no singularity test: transformMatrix and transformPair write them
+// without this function (no call of makeTransform, no matrix returned through two frames).
 Affine checkedTransform(const Graph& g, NodeId n, EvalState s, double* a) {
     const Transform& t = g.transforms[g.nodes[n].payload];
     argumentsOf(g, t, s, a);
-    if (t.op == TransformOp::Move || t.op == TransformOp::ZShear) return makeTransform(t.op, a);
     const FileLoc loc = t.argCount ? g.exprs[g.args[t.firstArg]].loc : g.nodes[n].loc;
     if (t.op == TransformOp::Rot && a[0] == 0 && a[1] == 0 && a[2] == 0)
         throw RuntimeError(
@@ -477,7 +503,11 @@ Affine transformMatrix(const Graph& g, NodeId n, EvalState s) {
     const Transform& t = g.transforms[g.nodes[n].payload];
     if (t.constant) return t.matrix;
     double a[12];
-    return checkedTransform(g, n, s, a);
+    if (!isUnitShear(t.op)) return checkedTransform(g, n, s, a);
+    argumentsOf(g, t, s, a);
+    Affine m;
+    writeUnitShear(t.op, a, m);
+    return m;
 }
 
 void transformPair(const Graph& g, NodeId n, EvalState s, Affine& forward, Affine& inverse) {
@@ -488,7 +518,13 @@ void transformPair(const Graph& g, NodeId n, EvalState s, Affine& forward, Affin
         return;
     }
     double a[12];
-    forward = checkedTransform(g, n, s, a);
+    if (isUnitShear(t.op)) {
+        argumentsOf(g, t, s, a);
+        forward = Affine::identity();
+        writeUnitShear(t.op, a, forward);
+    } else {
+        forward = checkedTransform(g, n, s, a);
+    }
     inverse = inverseOf(t.op, a, forward);
 }
 

@@ -309,6 +309,41 @@ TEST(Eval, ZeroScaleIsARuntimeError) {
     EXPECT_THROW(transformMatrix(g, t, {frame, kRootPath}), RuntimeError);
 }
 
+// move() and zshear() of parameters take their own path in transformMatrix and
+// transformPair (no singularity test, no makeTransform call): the matrices must be the ones
+// the language table gives, their inverses the general inverse's, bit for bit (signed
+// zeros included), and a non-finite argument must still be the run-time error.
+TEST(Eval, ParameterMoveAndZShearAreTheTablesMatricesBitForBit) {
+    Graph g;
+    const Slot x = g.slot("x"), y = g.slot("y"), z = g.slot("z");
+    g.args = {g.addLoad(x), g.addLoad(y), g.addLoad(z)};
+    g.transforms.push_back(Transform{TransformOp::Move, 0, 3, false, {}});
+    g.transforms.push_back(Transform{TransformOp::ZShear, 1, 2, false, {}});
+    const NodeId move = g.addNode(NodeKind::Transform, 0, {});
+    const NodeId shear = g.addNode(NodeKind::Transform, 1, {});
+    const double values[][3] = {{0.5, -2, 3}, {-0.0, 0.0, -0.0}, {1e300, -4.9e-324, 7}};
+    for (const auto& v : values) {
+        double frame[3] = {v[0], v[1], v[2]};
+        Affine moved = Affine::identity(), sheared = Affine::identity();
+        moved.t = {v[0], v[1], v[2]};
+        sheared.l[2][0] = v[1], sheared.l[2][1] = v[2];
+        for (const auto& [n, want] : {std::pair{move, moved}, std::pair{shear, sheared}}) {
+            const EvalState s{frame, kRootPath};
+            EXPECT_EQ(bitsOf(transformMatrix(g, n, s)), bitsOf(want)) << v[0] << " " << v[1];
+            Affine forward, inverse;
+            transformPair(g, n, s, forward, inverse);
+            EXPECT_EQ(bitsOf(forward), bitsOf(want));
+            EXPECT_EQ(bitsOf(inverse), bitsOf(want.inverse()));
+        }
+    }
+    double frame[3] = {1, 2, std::numeric_limits<double>::infinity()};
+    for (NodeId n : {move, shear}) {
+        Affine forward, inverse;
+        EXPECT_THROW(transformMatrix(g, n, {frame, kRootPath}), RuntimeError);
+        EXPECT_THROW(transformPair(g, n, {frame, kRootPath}, forward, inverse), RuntimeError);
+    }
+}
+
 TEST(Eval, RandomnessIsPureAndUniform) {
     EXPECT_EQ(randOf(1, 0.25), randOf(1, 0.25));
     EXPECT_EQ(randOf(1, 0.0), randOf(1, -0.0));

@@ -203,6 +203,47 @@ TEST(InstanceBoxes, TheBoxDoesNotDependOnWhatTheCacheHeld) {
     }
 }
 
+// The box of an instance whose rule is move() zshear() of a primitive without arguments
+// is the rule's: the primitive's own box (primitiveBox) mapped by the product of the two
+// matrices, rounded outwards to floats, mapped by the instance's identity and padded, bit
+// for bit, for every such kind (the walk's sink keeps their own boxes in a table).
+TEST(InstanceBoxes, ABoxOfAPrimitiveWithoutArgumentsIsTheRulesBitForBit) {
+    size_t kinds = 0;
+    for (const PrimitiveInfo& p : kPrimitiveTable) {
+        if (p.args != 0 || p.kind == PrimitiveKind::Empty) continue;
+        ++kinds;
+        const std::string text = std::string("{z = 0.25; a = 0.5; b = -0.75} P\nP 1\n") +
+                                 "1: P -> move(0.5, 0, z) zshear(a, b) " + p.name + "\n";
+        auto c = compile(text.c_str());
+        ASSERT_TRUE(c->graph) << p.name;
+        const Graph& g = *c->graph;
+        const Bounds bounds = computeBounds(g);
+        const InstanceBoxes boxes(g, bounds, always());
+        auto worker = boxes.makeWorker();
+        std::vector<double> frame(g.slotCount()), f(g.slotCount());
+        initFrame(g, frame.data());
+        const NodeId calc = g.axiom, s = g.child(calc);
+        ASSERT_EQ(g.nodes[s].kind, NodeKind::Select) << p.name;
+        applyCalc(g, calc, EvalState{frame.data(), kRootPath}, f.data());
+        const double moved[] = {0.5, 0, 0.25}, sheared[] = {0.5, -0.75};
+        const Affine world =
+            makeTransform(TransformOp::Move, moved) * makeTransform(TransformOp::ZShear, sheared);
+        const Box local = transformBox(world, primitiveBox(p.kind, nullptr));
+        Box rounded;
+        for (int j = 0; j < 3; ++j)
+            rounded.lo[j] = castDown(local.lo[j]), rounded.hi[j] = castUp(local.hi[j]);
+        const Box want = paddedBox(transformBox(Affine::identity(), rounded));
+        const Box got = boxes.box(*worker, s, 1, f.data(), kRootPath);
+        for (int j = 0; j < 3; ++j) {
+            EXPECT_EQ(std::bit_cast<uint64_t>(got.lo[j]), std::bit_cast<uint64_t>(want.lo[j]))
+                << p.name << " axis " << j;
+            EXPECT_EQ(std::bit_cast<uint64_t>(got.hi[j]), std::bit_cast<uint64_t>(want.hi[j]))
+                << p.name << " axis " << j;
+        }
+    }
+    EXPECT_EQ(kinds, 8u);
+}
+
 // Every S-node instance of a small system (node, depth, frame, path), by a recursive walk.
 struct SelectInstance {
     NodeId node;
