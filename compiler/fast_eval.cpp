@@ -109,10 +109,19 @@ inline double mulFirstNan(double a, double b) {
         if (acc != acc && a != a) acc = a + a;      \
     }                                               \
     PCSG_FAST_NEXT;
+// The Store or StoreKeep after a fused run, done without its dispatch (the terrain's runs
+// end values: the seed is kept for rand(sd), rnd and the height are stored).
+#define PCSG_FAST_THEN_STORE                    \
+    if (pc->op == FastOp::Store) {              \
+        out[pc->a] = acc, acc = st[--sp], ++pc; \
+    } else if (pc->op == FastOp::StoreKeep) {   \
+        if (unassignedBits(acc)) return false;  \
+        out[pc->a] = acc, ++pc;                 \
+    }
 // AddMulKL, then the fused runs (fast_instr.h): this instruction and the next ones'
 // operands, each operation as its own instruction computes it (an unassigned read stops
 // the run; nothing is stored before it, so stopping earlier or later gives the same), then
-// pc skips the run.
+// pc skips the run (and does the store after it).
 #define PCSG_FAST_FUSED_RUNS                                                            \
     PCSG_FAST_ADD_MUL_KL                                                                \
     PCSG_FAST_OP(SumMulKL4) {                                                           \
@@ -126,6 +135,7 @@ inline double mulFirstNan(double a, double b) {
         acc = addFirstNan(acc, mulFirstNan(in[2].imm, x2));                             \
         acc = addFirstNan(acc, mulFirstNan(in[3].imm, x3));                             \
         pc += 3;                                                                        \
+        PCSG_FAST_THEN_STORE                                                            \
     }                                                                                   \
     PCSG_FAST_NEXT;                                                                     \
     PCSG_FAST_OP(RandLnChain) {                                                         \
@@ -135,6 +145,7 @@ inline double mulFirstNan(double a, double b) {
         const double l = lnRecalled(addFirstNan(mulFirstNan(u, in[1].imm), in[2].imm)); \
         acc = mulFirstNan(addFirstNan(-l, in[5].imm), x);                               \
         pc += 6;                                                                        \
+        PCSG_FAST_THEN_STORE                                                            \
     }                                                                                   \
     PCSG_FAST_NEXT;                                                                     \
     PCSG_FAST_OP(MeanAddL) {                                                            \
@@ -145,6 +156,7 @@ inline double mulFirstNan(double a, double b) {
         st[sp++] = acc;                                                                 \
         acc = addFirstNan(addFirstNan(a, b) / in[1].imm, c);                            \
         pc += 2;                                                                        \
+        PCSG_FAST_THEN_STORE                                                            \
     }                                                                                   \
     PCSG_FAST_NEXT;
 #define PCSG_FAST_FIRST_NAN(SYMBOL) \
@@ -246,6 +258,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 #undef PCSG_FAST_BINARY
 #undef PCSG_FAST_ADD_MUL_KL
 #undef PCSG_FAST_FUSED_RUNS
+#undef PCSG_FAST_THEN_STORE
 #undef PCSG_FAST_UNARY
 #undef PCSG_FAST_PUSH
 #undef PCSG_FAST_FIRST_NAN
