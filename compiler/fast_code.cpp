@@ -169,6 +169,39 @@ uint32_t fuse(const Graph& g, uint32_t pc, uint32_t end, const std::vector<uint8
     return 1;
 }
 
+// The runs of instructions that one fused instruction does (fast_instr.h): the run's first
+// instruction becomes the fused one; the others stay, for their operands and for a jump
+// that lands inside the run (it runs them one by one, as before).
+struct FusedRun {
+    FastOp fused;
+    std::vector<FastOp> ops;
+};
+const FusedRun kFusedRuns[] = {
+    {FastOp::SumMulKL4, {FastOp::MulKL, FastOp::AddMulKL, FastOp::AddMulKL, FastOp::AddMulKL}},
+    {FastOp::RandLnChain,
+     {FastOp::Rand1, FastOp::MulK, FastOp::AddK, FastOp::Ln, FastOp::Neg, FastOp::AddK,
+      FastOp::MulL}},
+    {FastOp::MeanAddL, {FastOp::AddLL, FastOp::DivK, FastOp::AddL}},
+};
+
+bool runAt(const Graph& g, size_t i, const FusedRun& run) {
+    if (i + run.ops.size() > g.fastCode.size()) return false;
+    for (size_t k = 0; k < run.ops.size(); ++k)
+        if (g.fastCode[i + k].op != run.ops[k]) return false;
+    return true;
+}
+
+// Writes the fused op over the first instruction of each run in g.fastCode[first, ..).
+void fuseRuns(Graph& g, size_t first) {
+    for (size_t i = first; i < g.fastCode.size(); ++i)
+        for (const FusedRun& run : kFusedRuns)
+            if (runAt(g, i, run)) {
+                g.fastCode[i].op = run.fused;
+                i += run.ops.size() - 1;
+                break;
+            }
+}
+
 // Appends the fast form of the plain code [begin, end) to g.fastCode, without its End;
 // false (and nothing appended) when the fast machine cannot run it. `held`: the slot the
 // instruction before stored and that acc still holds (a Store that may become StoreKeep).
@@ -202,6 +235,7 @@ bool translate(Graph& g, uint32_t begin, uint32_t end, Slot held = kNone) {
     }
     newPc[end - begin] = static_cast<uint32_t>(g.fastCode.size());
     for (size_t j : jumps) g.fastCode[j].a = newPc[g.fastCode[j].a - begin];
+    fuseRuns(g, first);
     return true;
 }
 
@@ -279,11 +313,12 @@ std::string dumpFrom(const Graph& g, uint32_t start) {
         out += fmt::format("{:4}  {}", pc - start, kOpNames[op]);
         if (in.op == FastOp::PushK || (in.op >= FastOp::AddK && in.op <= FastOp::NeK))
             out += fmt::format(" {}", in.imm);
-        else if ((in.op >= FastOp::AddKL && in.op <= FastOp::NeKL) || in.op == FastOp::AddMulKL)
+        else if ((in.op >= FastOp::AddKL && in.op <= FastOp::NeKL) || in.op == FastOp::AddMulKL ||
+                 in.op == FastOp::SumMulKL4)
             out += fmt::format(" {} {}", in.imm, slotName(g, in.a));
         else if (in.op >= FastOp::AddLK && in.op <= FastOp::NeLK)
             out += fmt::format(" {} {}", slotName(g, in.a), in.imm);
-        else if (in.op >= FastOp::AddLL && in.op <= FastOp::NeLL)
+        else if ((in.op >= FastOp::AddLL && in.op <= FastOp::NeLL) || in.op == FastOp::MeanAddL)
             out += fmt::format(" {} {}", slotName(g, in.a), slotName(g, in.b));
         else if (in.op == FastOp::PushL || in.op == FastOp::Store || in.op == FastOp::StoreKeep ||
                  (in.op >= FastOp::AddL && in.op <= FastOp::NeL))

@@ -416,6 +416,79 @@ TEST(FastCode, ATNodesProgramStoresEveryArgument) {
     EXPECT_EQ(stopped, 1u);
 }
 
+// The graph with each fused instruction (fast_instr.h) back to the first of its run: the
+// run's instructions one by one.
+Graph unfusedOf(const Graph& g) {
+    Graph u = g;
+    for (FastInstr& f : u.fastCode) {
+        if (f.op == FastOp::SumMulKL4) f.op = FastOp::MulKL;
+        if (f.op == FastOp::RandLnChain) f.op = FastOp::Rand1;
+        if (f.op == FastOp::MeanAddL) f.op = FastOp::AddLL;
+    }
+    return u;
+}
+
+TEST(FastCode, FusedRunsGiveTheBitsOfTheirInstructionsOneByOne) {
+    // The terrain's C-node: a seed, the rnd of its rand() (reading the seed just stored),
+    // a mean height plus rnd; then a mean that a jump enters after its first instruction.
+    auto c =
+        withExprs({"2.5*x + 3*y + 0.5*z + 7*x", "((-ln(rand(r1)*0.75+1.0))+0.125)*z",
+                   "(x+y)/2.0 + r2", "(if(x, y+z, z+y))/2.0 + x", "((-ln(rand(x)*y+1.0))+0.5)*x"});
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    expectSameValues(g, 2000);  // the plain code's values
+    const std::string dump = dumpFastCalc(g, calcUnderTest(g));
+    for (const char* form : {"SumMulKL4 2.5 x\n", "RandLnChain\n", "MeanAddL x y\n",
+                             "MeanAddL z y\n", "StoreKeep r1\n"})
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+    EXPECT_EQ(dump.find("RandLnChain", dump.find("RandLnChain") + 1), std::string::npos)
+        << "rand(x)*y is not the run's MulK\n"
+        << dump;
+    // the unfused instructions' bits, NaNs' signs and payloads included
+    const Graph unfused = unfusedOf(g);
+    const NodeId node = calcNodeUnderTest(g);
+    std::mt19937 rng(11);
+    std::vector<double> frame, fused(g.slotCount()), oneByOne(g.slotCount());
+    for (int k = 0; k < 4000; ++k) {
+        randomFrame(g, rng, frame);
+        const EvalState s{frame.data(), pathChild(kRootPath, k)};
+        applyCalc(g, node, s, fused.data());
+        applyCalc(unfused, node, s, oneByOne.data());
+        for (Slot i = 0; i < g.slotCount(); ++i)
+            ASSERT_EQ(std::bit_cast<uint64_t>(fused[i]), std::bit_cast<uint64_t>(oneByOne[i]))
+                << g.slotNames[i] << " with " << describeFrame(g, frame.data()) << "\n"
+                << dump;
+    }
+}
+
+TEST(FastCode, FusedRunsReportUnassignedReadsAsThePlainCodeDoes) {
+    // w (assigned on another path only) read at each place of each run
+    const std::vector<std::string> exprs = {"2*w + 3*y + 4*z + 5*x",
+                                            "2*x + 3*w + 4*z + 5*x",
+                                            "2*x + 3*y + 4*w + 5*x",
+                                            "2*x + 3*y + 4*z + 5*w",
+                                            "((-ln(rand(x)*2+1.0))+0.5)*w",
+                                            "(w+y)/2.0 + z",
+                                            "(x+w)/2.0 + z",
+                                            "(x+y)/2.0 + w"};
+    auto c = withExprs(exprs);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Graph plain = plainOf(g);
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    for (Slot s = 0; s < g.slotCount(); ++s)
+        if (g.slotNames[s] != "w") frame[s] = 0.25;
+    const Calc& calc = g.calcs[calcUnderTest(g)];
+    EXPECT_NE(dumpFastCalc(g, calcUnderTest(g)).find("SumMulKL4"), std::string::npos);
+    for (uint32_t i = 0; i < calc.count; ++i) {
+        const ExprId e = g.assignments[calc.first + i].value;
+        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
+        EXPECT_NE(fast.find("'w'"), std::string::npos) << exprs[i] << ": " << fast;
+        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
+    }
+}
+
 TEST(FastCode, ChangingTheCodeDropsTheFastForm) {
     auto c = withExprs({"x + 1"});
     ASSERT_TRUE(c->graph);

@@ -16,6 +16,17 @@ constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 inline bool unassignedBits(double v) {
     return std::bit_cast<uint64_t>(v) == kUnassignedBits;
 }
+
+// a + b and a * b with the first operand's NaN, as the machine's Add and Mul give them (see
+// PCSG_FAST_BINARY): for the fused runs, which do several of them in one instruction.
+inline double addFirstNan(double a, double b) {
+    const double r = a + b;
+    return r != r && a != a ? a + a : r;
+}
+inline double mulFirstNan(double a, double b) {
+    const double r = a * b;
+    return r != r && a != a ? a * a : r;
+}
 }  // namespace
 
 // The machine is threaded: each operation ends by jumping straight to the next one's code
@@ -98,6 +109,56 @@ inline bool unassignedBits(double v) {
         if (acc != acc && a != a) acc = a + a;      \
     }                                               \
     PCSG_FAST_NEXT;
+// The Store or StoreKeep after a fused run, done without its dispatch (the terrain's runs
+// end values: the seed is kept for rand(sd), rnd and the height are stored).
+#define PCSG_FAST_THEN_STORE                    \
+    if (pc->op == FastOp::Store) {              \
+        out[pc->a] = acc, acc = st[--sp], ++pc; \
+    } else if (pc->op == FastOp::StoreKeep) {   \
+        if (unassignedBits(acc)) return false;  \
+        out[pc->a] = acc, ++pc;                 \
+    }
+// AddMulKL, then the fused runs (fast_instr.h): this instruction and the next ones'
+// operands, each operation as its own instruction computes it (an unassigned read stops
+// the run; nothing is stored before it, so stopping earlier or later gives the same), then
+// pc skips the run (and does the store after it).
+#define PCSG_FAST_FUSED_RUNS                                                            \
+    PCSG_FAST_ADD_MUL_KL                                                                \
+    PCSG_FAST_OP(SumMulKL4) {                                                           \
+        const double x0 = frame[in[0].a], x1 = frame[in[1].a];                          \
+        const double x2 = frame[in[2].a], x3 = frame[in[3].a];                          \
+        if (unassignedBits(x0) || unassignedBits(x1)) return false;                     \
+        if (unassignedBits(x2) || unassignedBits(x3)) return false;                     \
+        st[sp++] = acc;                                                                 \
+        acc = mulFirstNan(in[0].imm, x0);                                               \
+        acc = addFirstNan(acc, mulFirstNan(in[1].imm, x1));                             \
+        acc = addFirstNan(acc, mulFirstNan(in[2].imm, x2));                             \
+        acc = addFirstNan(acc, mulFirstNan(in[3].imm, x3));                             \
+        pc += 3;                                                                        \
+        PCSG_FAST_THEN_STORE                                                            \
+    }                                                                                   \
+    PCSG_FAST_NEXT;                                                                     \
+    PCSG_FAST_OP(RandLnChain) {                                                         \
+        const double x = frame[in[6].a];                                                \
+        if (unassignedBits(x)) return false;                                            \
+        const double u = randOfInline(seed, acc);                                       \
+        const double l = lnRecalled(addFirstNan(mulFirstNan(u, in[1].imm), in[2].imm)); \
+        acc = mulFirstNan(addFirstNan(-l, in[5].imm), x);                               \
+        pc += 6;                                                                        \
+        PCSG_FAST_THEN_STORE                                                            \
+    }                                                                                   \
+    PCSG_FAST_NEXT;                                                                     \
+    PCSG_FAST_OP(MeanAddL) {                                                            \
+        const double a = frame[in[0].a], b = frame[in[0].b];                            \
+        const double c = frame[in[2].a];                                                \
+        if (unassignedBits(a) || unassignedBits(b)) return false;                       \
+        if (unassignedBits(c)) return false;                                            \
+        st[sp++] = acc;                                                                 \
+        acc = addFirstNan(addFirstNan(a, b) / in[1].imm, c);                            \
+        pc += 2;                                                                        \
+        PCSG_FAST_THEN_STORE                                                            \
+    }                                                                                   \
+    PCSG_FAST_NEXT;
 #define PCSG_FAST_FIRST_NAN(SYMBOL) \
     if (acc != acc && a != a) acc = a SYMBOL a
 #define PCSG_FAST_NO_FIX (void)0
@@ -163,7 +224,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
     PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_ADD_MUL_KL
+    PCSG_FAST_FUSED_RUNS
     PCSG_FAST_OP(Call) {
         st[sp] = acc, sp -= in->argc - 1u;
         acc = callFunc(static_cast<Func>(in->a), st + sp, in->argc, seed);
@@ -196,6 +257,8 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 
 #undef PCSG_FAST_BINARY
 #undef PCSG_FAST_ADD_MUL_KL
+#undef PCSG_FAST_FUSED_RUNS
+#undef PCSG_FAST_THEN_STORE
 #undef PCSG_FAST_UNARY
 #undef PCSG_FAST_PUSH
 #undef PCSG_FAST_FIRST_NAN

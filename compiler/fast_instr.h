@@ -50,6 +50,12 @@ namespace pcsg {
     X(AddLL) X(SubLL) X(MulLL) X(DivLL) X(ModLL) X(PowLL) PCSG_FAST_COMPARISONS(X, LL)    \
     /* acc = acc + imm * frame[a] (checked as PushL): MulKL and the Add after it */       \
     X(AddMulKL)                                                                           \
+    /* Fused runs of the instructions above, written over the first of the run: the rest  \
+       of the run stays in place and gives its operands; the machine skips it. The same   \
+       operations in the same order, each with its own NaN fix and check. */              \
+    X(SumMulKL4)   /* MulKL, AddMulKL, AddMulKL, AddMulKL: a terrain's seed */            \
+    X(RandLnChain) /* Rand1, MulK, AddK, Ln, Neg, AddK, MulL: a terrain's rnd */          \
+    X(MeanAddL)    /* AddLL, DivK, AddL: a terrain's (z1+z2)/2.0 + rnd */                 \
     /* argc values (acc the last): acc = Func a of them / choose() at call site a */      \
     X(Call)                                                                               \
     X(Choose)                                                                             \
