@@ -489,6 +489,37 @@ TEST(FastCode, FusedRunsReportUnassignedReadsAsThePlainCodeDoes) {
     }
 }
 
+TEST(FastCode, TwoLeavesAndTheirOperatorStoreWithoutTheStoresDispatch) {
+    // Each form that spills acc, then a Store (done by the form); a jump that lands on the
+    // Store after a SubLL (if's else branch), and a value read from the slot just stored.
+    auto c = withExprs({"x-y", "2*z", "y/4", "if(x, z, y-z)", "x-z", "r5+y", "x<z", "x^y", "3%z"});
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const std::string dump = dumpFastCalc(g, calcUnderTest(g));
+    for (const char* form : {"SubLL x y\n   1  Store r1\n", "MulKL 2 z\n   3  Store r2\n",
+                             "DivLK y 4\n   5  Store r3\n", "SubLL y z\n  11  Store r4\n",
+                             "SubLL x z\n  13  StoreKeep r5\n"})
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+    expectSameValues(g, 2000);
+    // each slot stored once, with its own value
+    std::vector<double> frame(g.slotCount()), out(g.slotCount(), std::nan("5"));
+    initFrame(g, frame.data());
+    for (Slot s = 0; s < g.slotCount(); ++s)
+        if (g.slotNames[s] != "w") frame[s] = 1.5 + s;
+    double unused;
+    ASSERT_TRUE(
+        runFast(g, g.calcs[calcUnderTest(g)].fast, frame.data(), out.data(), kRootPath, unused));
+    const EvalState s{frame.data(), kRootPath};
+    for (uint32_t i = 0; i < 9; ++i) {
+        const Assignment& as = g.assignments[g.calcs[calcUnderTest(g)].first + i];
+        if (i == 5) continue;  // r5+y reads r5 as stored, not from `frame`
+        EXPECT_EQ(std::bit_cast<uint64_t>(out[as.slot]),
+                  std::bit_cast<uint64_t>(evalExpr(g, as.value, s)))
+            << g.slotNames[as.slot] << "\n"
+            << dump;
+    }
+}
+
 TEST(FastCode, ChangingTheCodeDropsTheFastForm) {
     auto c = withExprs({"x + 1"});
     ASSERT_TRUE(c->graph);

@@ -45,6 +45,18 @@ inline double mulFirstNan(double a, double b) {
     } while (0)
 #define PCSG_FAST_OP(OP) op_##OP:
 
+// The end of a form that spills acc (two leaves and their operator): when a Store follows
+// (a C-node's `x2 = x1-kl`, a T-node's argument `z2-z1`), it is done here without its
+// dispatch, and acc is not spilled, since the Store would pop it straight back. The same
+// value in the same slot, the same stack after; a jump to the Store still runs it alone.
+#define PCSG_FAST_SPILL_OR_STORE(KEPT)            \
+    do {                                          \
+        if (pc->op == FastOp::Store) {            \
+            out[pc->a] = acc, acc = (KEPT), ++pc; \
+        } else {                                  \
+            st[sp++] = (KEPT);                    \
+        }                                         \
+    } while (0)
 // One binary operator in its six forms: the left operand popped, then a constant, a
 // parameter, both leaves (constant and parameter, parameter and constant, two parameters). `FIX`
 // runs after the operation: for Add and Mul of two NaNs, x86 gives the first operand's NaN
@@ -74,17 +86,19 @@ inline double mulFirstNan(double a, double b) {
     PCSG_FAST_OP(OP##KL) {                          \
         const double a = in->imm, b = frame[in->a]; \
         if (unassignedBits(b)) return false;        \
-        st[sp++] = acc;                             \
+        const double kept = acc;                    \
         acc = (EXPR);                               \
         FIX;                                        \
+        PCSG_FAST_SPILL_OR_STORE(kept);             \
     }                                               \
     PCSG_FAST_NEXT;                                 \
     PCSG_FAST_OP(OP##LK) {                          \
         const double a = frame[in->a], b = in->imm; \
         if (unassignedBits(a)) return false;        \
-        st[sp++] = acc;                             \
+        const double kept = acc;                    \
         acc = (EXPR);                               \
         FIX;                                        \
+        PCSG_FAST_SPILL_OR_STORE(kept);             \
     }                                               \
     PCSG_FAST_NEXT;                                 \
     PCSG_FAST_OP(OP##LL) {                          \
@@ -92,9 +106,10 @@ inline double mulFirstNan(double a, double b) {
         const double b = frame[in->b];              \
         if (unassignedBits(a)) return false;        \
         if (unassignedBits(b)) return false;        \
-        st[sp++] = acc;                             \
+        const double kept = acc;                    \
         acc = (EXPR);                               \
         FIX;                                        \
+        PCSG_FAST_SPILL_OR_STORE(kept);             \
     }                                               \
     PCSG_FAST_NEXT;
 // MulKL and the Add that takes its product: MulKL's value and NaN fix, then Add's.
@@ -256,6 +271,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 }
 
 #undef PCSG_FAST_BINARY
+#undef PCSG_FAST_SPILL_OR_STORE
 #undef PCSG_FAST_ADD_MUL_KL
 #undef PCSG_FAST_FUSED_RUNS
 #undef PCSG_FAST_THEN_STORE
