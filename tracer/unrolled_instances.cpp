@@ -606,22 +606,23 @@ class Unroller {
         }
         const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
         out_.bvh_.emplace_back();
+        double lo[3][4] = {}, hi[3][4] = {};  // (an empty slot: 0 to 0, never entered)
         for (int k = 0; k < 4; ++k) {
             uint32_t child = kNone, link = kNone;
-            Box box{{0, 0, 0}, {0, 0, 0}};  // an empty slot: never entered
             if (k < n) {
-                box = slots[k].box;
+                for (int a = 0; a < 3; ++a) lo[a][k] = slots[k].box.lo[a];
+                for (int a = 0; a < 3; ++a) hi[a][k] = slots[k].box.hi[a];
                 link = slots[k].link;
                 child = (slots[k].child & UnrolledInstance::kLeaf) ? slots[k].child
                                                                    : collapse(slots[k].child);
             }
-            BvhNode& b = out_.bvh_[index];
-            for (int a = 0; a < 3; ++a) {
-                b.lo[a][k] = floatBelow(box.lo[a]);
-                b.hi[a][k] = floatAbove(box.hi[a]);
-            }
-            b.child[k] = child;
-            b.link[k] = link;
+            out_.bvh_[index].child[k] = child;
+            out_.bvh_[index].link[k] = link;
+        }
+        BvhNode& b = out_.bvh_[index];
+        for (int a = 0; a < 3; ++a) {
+            floatsBelow(lo[a], b.lo[a]);
+            floatsAbove(hi[a], b.hi[a]);
         }
         return index;
     }
