@@ -435,6 +435,7 @@ class Unroller {
                  std::vector<Item>& items) {
         const Node un = out_.nodes_[u];
         const size_t base = parts_.size();
+        const bool loose = link != kNone && !scaledPermutation(toU);  // (the same for all)
         for (uint32_t i = 0; i < un.count; ++i) {
             const uint32_t c = out_.children_[un.first + i];
             const Node& child = out_.nodes_[c];
@@ -452,7 +453,7 @@ class Unroller {
             }
             const Box box =
                 link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
-            out_.nodes_[c].looseInBvh = link != kNone && !scaledPermutation(toU);
+            out_.nodes_[c].looseInBvh = loose;
             items.push_back({c, link, box});
             parts_.push_back({c | UnrolledInstance::kLeaf, link, box, 0});
         }
