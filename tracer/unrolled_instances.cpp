@@ -435,6 +435,7 @@ class Unroller {
                  std::vector<Item>& items) {
         const Node un = out_.nodes_[u];
         const size_t base = parts_.size();
+        const bool loose = link != kNone && !scaledPermutation(toU);  // (the same for all)
         for (uint32_t i = 0; i < un.count; ++i) {
             const uint32_t c = out_.children_[un.first + i];
             const Node& child = out_.nodes_[c];
@@ -452,7 +453,7 @@ class Unroller {
             }
             const Box box =
                 link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
-            out_.nodes_[c].looseInBvh = link != kNone && !scaledPermutation(toU);
+            out_.nodes_[c].looseInBvh = loose;
             items.push_back({c, link, box});
             parts_.push_back({c | UnrolledInstance::kLeaf, link, box, 0});
         }
@@ -606,22 +607,23 @@ class Unroller {
         }
         const uint32_t index = static_cast<uint32_t>(out_.bvh_.size());
         out_.bvh_.emplace_back();
+        double lo[3][4] = {}, hi[3][4] = {};  // (an empty slot: 0 to 0, never entered)
         for (int k = 0; k < 4; ++k) {
             uint32_t child = kNone, link = kNone;
-            Box box{{0, 0, 0}, {0, 0, 0}};  // an empty slot: never entered
             if (k < n) {
-                box = slots[k].box;
+                for (int a = 0; a < 3; ++a) lo[a][k] = slots[k].box.lo[a];
+                for (int a = 0; a < 3; ++a) hi[a][k] = slots[k].box.hi[a];
                 link = slots[k].link;
                 child = (slots[k].child & UnrolledInstance::kLeaf) ? slots[k].child
                                                                    : collapse(slots[k].child);
             }
-            BvhNode& b = out_.bvh_[index];
-            for (int a = 0; a < 3; ++a) {
-                b.lo[a][k] = floatBelow(box.lo[a]);
-                b.hi[a][k] = floatAbove(box.hi[a]);
-            }
-            b.child[k] = child;
-            b.link[k] = link;
+            out_.bvh_[index].child[k] = child;
+            out_.bvh_[index].link[k] = link;
+        }
+        BvhNode& b = out_.bvh_[index];
+        for (int a = 0; a < 3; ++a) {
+            floatsBelow(lo[a], b.lo[a]);
+            floatsAbove(hi[a], b.hi[a]);
         }
         return index;
     }

@@ -242,6 +242,76 @@ TEST(ExpandedInstances, BoxesRoundOutwardsToFloats) {
     EXPECT_TRUE(std::isnan(floatAbove(std::nan(""))));
 }
 
+// The doubles where rounding outwards to floats can go wrong: every float of a stride
+// through all bit patterns, the powers of two and the edges (zeros, subnormals, FLT_MIN,
+// FLT_MAX, infinities, NaNs), each as a double, one double step either side of it, the
+// midpoint to the next float (a tie) and one step either side of that; and doubles far
+// beyond floats (subnormal and huge).
+std::vector<double> roundingEdgeCases() {
+    const float fmax = std::numeric_limits<float>::max();
+    std::vector<float> fs = {0.0f,
+                             -0.0f,
+                             std::numeric_limits<float>::denorm_min(),
+                             std::numeric_limits<float>::min(),
+                             fmax,
+                             1.0f,
+                             0.1f};
+    for (uint64_t bits = 0; bits < (1ull << 32); bits += 16411)
+        fs.push_back(std::bit_cast<float>(static_cast<uint32_t>(bits)));
+    for (int e = -150; e <= 128; ++e) fs.push_back(std::ldexp(1.0f, e));
+    const size_t n = fs.size();
+    for (size_t i = 0; i < n; ++i) fs.push_back(-fs[i]);
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> xs = {inf,
+                              -inf,
+                              std::nan(""),
+                              -std::nan(""),
+                              std::numeric_limits<double>::max(),
+                              -1e300,
+                              std::numeric_limits<double>::denorm_min(),
+                              -1e-310,
+                              1e-50};
+    for (float f : fs) {
+        const double d = f;
+        const double next = std::isfinite(f) ? std::nextafter(f, INFINITY) : d;
+        const double tie = std::isfinite(next) ? (d + next) / 2 : d + std::ldexp(1.0, 103);
+        for (double x : {d, tie})
+            xs.insert(xs.end(), {x, std::nextafter(x, -inf), std::nextafter(x, inf)});
+    }
+    return xs;
+}
+
+TEST(ExpandedInstances, FourBoundsRoundLikeOne) {
+    const std::vector<double> xs = roundingEdgeCases();
+    ASSERT_GT(xs.size(), 1'500'000u);
+    size_t mismatches = 0;
+    for (size_t shift = 0; shift < 4; ++shift) {  // (each value in each of the four lanes)
+        for (size_t i = shift; i + 4 <= xs.size(); i += 4) {
+            float below[4], above[4];
+            floatsBelow(&xs[i], below);
+            floatsAbove(&xs[i], above);
+            for (int k = 0; k < 4; ++k) {
+                const bool same = std::bit_cast<uint32_t>(below[k]) ==
+                                      std::bit_cast<uint32_t>(floatBelow(xs[i + k])) &&
+                                  std::bit_cast<uint32_t>(above[k]) ==
+                                      std::bit_cast<uint32_t>(floatAbove(xs[i + k]));
+                if (!same && ++mismatches < 10) ADD_FAILURE() << "x = " << xs[i + k];
+            }
+        }
+    }
+    EXPECT_EQ(mismatches, 0u);
+    // and the one-at-a-time rounding is the outward one at the edges
+    const float fmax = std::numeric_limits<float>::max();
+    const double inf = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(floatBelow(inf), fmax);
+    EXPECT_EQ(floatAbove(-inf), -fmax);
+    EXPECT_EQ(floatBelow(-1e300), -inf);
+    EXPECT_EQ(floatAbove(1e-310), std::numeric_limits<float>::denorm_min());
+    EXPECT_EQ(std::bit_cast<uint32_t>(floatBelow(-1e-310)), 0x80000001u);
+    EXPECT_EQ(std::bit_cast<uint32_t>(floatBelow(-0.0)), 0x80000000u);
+    EXPECT_EQ(std::bit_cast<uint32_t>(floatAbove(0.0)), 0u);
+}
+
 TEST(ExpandedInstances, TheCacheStaysWithinItsBudget) {
     auto c = compile(kPlant);
     ASSERT_TRUE(c->graph);
