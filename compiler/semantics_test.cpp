@@ -153,5 +153,34 @@ TEST(Semantics, FromIdentityIsTheProductWithTheIdentityBitForBit) {
     EXPECT_TRUE(sameAffine(*fused.forward, t.sem.forwardThrough(Affine::identity(), chain, fused)));
 }
 
+// identityTimesIsExact looks at every one of the twelve words: -0, an infinity or a NaN in
+// any of them makes identity * m differ from m; +0, finite and subnormal values do not.
+TEST(Semantics, IdentityTimesIsExactTestsEachOfTheTwelveWords) {
+    const double inf = std::numeric_limits<double>::infinity();
+    const double inexact[] = {-0.0, inf, -inf, std::nan(""), -std::nan("")};
+    const double exact[] = {0.0, 1.0, -1.0, 4.9e-324, -4.9e-324, 1.7e308, -1.7e308};
+    for (int w = 0; w < 12; ++w) {
+        SCOPED_TRACE(::testing::Message() << "word " << w);
+        auto with = [&](double x) {
+            Affine m = Affine::translate({1, 2, 3}) * Affine::scale({2, -1, 0.5});
+            if (w < 9)
+                m.l[w / 3][w % 3] = x;
+            else
+                (w == 9 ? m.t.x : w == 10 ? m.t.y : m.t.z) = x;
+            return m;
+        };
+        for (double x : inexact) {
+            const Affine m = with(x);
+            EXPECT_FALSE(Semantics::identityTimesIsExact(m)) << x;
+            EXPECT_FALSE(sameAffine(Affine::identity() * m, m)) << x;
+        }
+        for (double x : exact) {
+            const Affine m = with(x);
+            EXPECT_TRUE(Semantics::identityTimesIsExact(m)) << x;
+            EXPECT_TRUE(sameAffine(Affine::identity() * m, m)) << x;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace pcsg

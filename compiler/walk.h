@@ -35,7 +35,11 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <new>
+#include <type_traits>
 #include <vector>
 
 #include "eval.h"
@@ -98,22 +102,23 @@ class Walker {
             std::copy(start.frame, start.frame + g_.slotCount(), arena_.begin());
         else
             initFrame(g_, arena_.data());
-        WalkEntry root{};
+        stack_.emplace_back();
+        WalkEntry& root = stack_.back().get();
+        root = WalkEntry{};
         root.node = start.node;
         root.depth = start.depth;
         root.material = start.material;
         root.path = start.path;
         root.world = Affine::identity();
         root.identity = true;
-        stack_.push_back(root);
         try {
             while (!stack_.empty()) step();
         } catch (RuntimeError& e) {
             // Every S-node on the stack, innermost first, so that enterModule (which
             // prepends) leaves the outermost first.
             for (size_t i = stack_.size(); i-- > (annotateStart ? 0 : 1);)
-                if (g_.nodes[stack_[i].node].kind == NodeKind::Select)
-                    e.enterModule(g_.modules[g_.nodes[stack_[i].node].payload].name);
+                if (g_.nodes[stack_[i].get().node].kind == NodeKind::Select)
+                    e.enterModule(g_.modules[g_.nodes[stack_[i].get().node].payload].name);
             throw;
         }
         return results_.back();
@@ -141,7 +146,7 @@ class Walker {
     }
 
     void step() {
-        WalkEntry& e = stack_.back();
+        WalkEntry& e = stack_.back().get();
         switch (g_.nodes[e.node].kind) {
             case NodeKind::Operator:
                 return stepOperator(e);
@@ -178,24 +183,41 @@ class Walker {
         const Step st = sem_.enter(e.node, stateOf(e), scratch);
         e.next = 1;
         const NodeId n = e.node;
-        // The child starts as a copy of e (made in place: e's entry is large), then changes.
-        stack_.push_back(e);  // (e may move: only the copy is used below)
-        WalkEntry& c = stack_.back();
+        // The child's entry is written field by field, its world once (not a copy of e's
+        // 168 bytes whose world a T- or S-step then overwrites).
+        const size_t parent = stack_.size() - 1;
+        stack_.emplace_back();  // (unwritten; e may move: only stack_[parent] is read below)
+        const WalkEntry& p = stack_[parent].get();
+        WalkEntry& c = stack_.back().get();
         c.node = st.child;
-        c.next = 0;
-        c.frame = frame;
-        c.path = st.state.path;
         c.depth = st.state.depth;
         c.material = st.state.material;
-        if (st.forward) {
-            Affine room;  // (from the identity: the step's own matrix where that is exact)
-            c.world =
-                c.identity ? sem_.fromIdentity(n, st, room) : sem_.forwardThrough(c.world, n, st);
-            c.identity = false;
-        }
+        c.next = 0;
+        c.frame = frame;
+        c.resultBase = p.resultBase;
+        c.path = st.state.path;
+        // (one by one: std::copy_n made a call to memmove of 32 bytes)
+        c.mark[0] = p.mark[0], c.mark[1] = p.mark[1], c.mark[2] = p.mark[2], c.mark[3] = p.mark[3];
+        childWorld(p, c, kind, n, st);
+    }
+
+    // The world of c, entered from p by the step st of the unary node n.
+    void childWorld(const WalkEntry& p, WalkEntry& c, NodeKind kind, NodeId n, const Step& st) {
         if (kind == NodeKind::Select && localSelectFrames()) {
             c.world = Affine::identity();
             c.identity = true;
+        } else if (!st.forward) {
+            c.world = p.world;
+            c.identity = p.identity;
+        } else if (!p.identity) {
+            c.world = sem_.forwardThrough(p.world, n, st);
+            c.identity = false;
+        } else {
+            // (from the identity: the step's own matrix where that is exact, else the
+            // product, written into c.world itself)
+            const Affine& w = sem_.fromIdentity(n, st, c.world);
+            if (&w != &c.world) c.world = w;
+            c.identity = false;
         }
     }
 
@@ -234,8 +256,8 @@ class Walker {
             const uint32_t i = e.next++;
             const NodeId child = g_.child(e.node, i);
             const uint64_t path = Semantics::operand(stateOf(e), i).path;
-            stack_.push_back(e);  // (in place, as in enterUnary)
-            WalkEntry& c = stack_.back();
+            stack_.emplace_back(e);  // (a copy made in place: e may move)
+            WalkEntry& c = stack_.back().get();
             c.node = child;
             c.next = 0;
             c.path = path;
@@ -262,7 +284,21 @@ class Walker {
     const Semantics& sem_;
     Sink& sink_;
     const size_t frameSize_;
-    std::vector<WalkEntry> stack_;
+    // The stack's element: room for an entry that a new element leaves unwritten
+    // (enterUnary writes every field; a WalkEntry made by its constructor would get its
+    // world set to the identity first). WalkEntry, an aggregate, is an implicit-lifetime
+    // type: the bytes' array begun by the placement new holds it (as StepScratch's room).
+    class StackEntry {
+      public:
+        StackEntry() { new (room_) std::byte[sizeof(WalkEntry)]; }
+        explicit StackEntry(const WalkEntry& w) { std::memcpy(room_, &w, sizeof(WalkEntry)); }
+        WalkEntry& get() { return *std::launder(reinterpret_cast<WalkEntry*>(room_)); }
+
+      private:
+        static_assert(std::is_aggregate_v<WalkEntry> && std::is_trivially_copyable_v<WalkEntry>);
+        alignas(WalkEntry) std::byte room_[sizeof(WalkEntry)];
+    };
+    std::vector<StackEntry> stack_;
     std::vector<double> arena_;  // the frames: [0, arenaTop_) in use
     size_t arenaTop_ = 0;
     std::vector<Result> results_;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <vector>
@@ -77,6 +78,34 @@ S 1
     expectSameBits(worlds[1], I * Affine::translate({-1, 3, 4}), 1);
     const Affine chain = I * Affine::translate({1, 2, 3}) * Affine::scale({2, 2, 2});
     expectSameBits(worlds[2], chain * Affine::translate({0, 0, -1}), 2);
+}
+
+// Records the world matrix of every primitive in the start node's frame (no local frames).
+struct GlobalWorldSink : WorldSink {
+    static constexpr bool kLocalSelectFrames = false;
+};
+
+// Without local frames the world goes on through S-, C- and paint nodes unchanged and
+// through every T-step as the product with the world above it.
+TEST(Walk, WorldsGoOnThroughEveryUnaryNodeAsTheProductsBitForBit) {
+    auto c = testing::compile(R"(
+{a = -1} S
+S 1
+1: S -> move(a, 2, 3) {b = a * 2} T
+T 1
+1: T -> paint(default) rotz(b * 10) (move(0, b, 1) sphere ∪ sphere)
+)");
+    ASSERT_TRUE(c->graph) << c->errors();
+    std::vector<Affine> worlds;
+    GlobalWorldSink sink{{worlds}};
+    const Semantics sem(*c->graph);
+    Walker<GlobalWorldSink> walker(sem, sink);
+    walker.run();
+    ASSERT_EQ(worlds.size(), 2u);
+    const Affine outer = Affine::identity() * Affine::translate({-1, 2, 3});
+    const Affine rotated = outer * makeTransform(TransformOp::RotZ, std::array{-20.0}.data());
+    expectSameBits(worlds[0], rotated * Affine::translate({0, -2, 1}), 0);
+    expectSameBits(worlds[1], rotated, 1);
 }
 
 }  // namespace
