@@ -17,8 +17,8 @@ inline bool unassignedBits(double v) {
     return std::bit_cast<uint64_t>(v) == kUnassignedBits;
 }
 
-// a + b and a * b with the first operand's NaN, as the machine's Add and Mul give them (see
-// PCSG_FAST_BINARY): for the fused runs, which do several of them in one instruction.
+// a + b and a * b with the first operand's NaN (see PCSG_FAST_BINARY): the one rule of the
+// machine's Add and Mul, AddMulKL and the fused runs.
 inline double addFirstNan(double a, double b) {
     const double r = a + b;
     return r != r && a != a ? a + a : r;
@@ -117,11 +117,7 @@ inline double mulFirstNan(double a, double b) {
     PCSG_FAST_OP(AddMulKL) {                        \
         const double k = in->imm, x = frame[in->a]; \
         if (unassignedBits(x)) return false;        \
-        double p = k * x;                           \
-        if (p != p && k != k) p = k * k;            \
-        const double a = acc;                       \
-        acc = a + p;                                \
-        if (acc != acc && a != a) acc = a + a;      \
+        acc = addFirstNan(acc, mulFirstNan(k, x));  \
     }                                               \
     PCSG_FAST_NEXT;
 // The Store or StoreKeep after a fused run, done without its dispatch (the terrain's runs
@@ -174,8 +170,6 @@ inline double mulFirstNan(double a, double b) {
         PCSG_FAST_THEN_STORE                                                            \
     }                                                                                   \
     PCSG_FAST_NEXT;
-#define PCSG_FAST_FIRST_NAN(SYMBOL) \
-    if (acc != acc && a != a) acc = a SYMBOL a
 #define PCSG_FAST_NO_FIX (void)0
 #define PCSG_FAST_PUSH(OP, EXPR) \
     PCSG_FAST_OP(OP)             \
@@ -227,9 +221,9 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
     PCSG_FAST_UNARY(Floor, std::floor(acc))
     PCSG_FAST_UNARY(Ceil, std::ceil(acc))
     PCSG_FAST_UNARY(Rand1, randOfInline(seed, acc))
-    PCSG_FAST_BINARY(Add, a + b, PCSG_FAST_FIRST_NAN(+))
+    PCSG_FAST_BINARY(Add, addFirstNan(a, b), PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Sub, a - b, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Mul, a * b, PCSG_FAST_FIRST_NAN(*))
+    PCSG_FAST_BINARY(Mul, mulFirstNan(a, b), PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Div, a / b, PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Mod, std::fmod(a, b), PCSG_FAST_NO_FIX)
     PCSG_FAST_BINARY(Pow, powRecalled(a, b), PCSG_FAST_NO_FIX)
@@ -277,7 +271,6 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 #undef PCSG_FAST_THEN_STORE
 #undef PCSG_FAST_UNARY
 #undef PCSG_FAST_PUSH
-#undef PCSG_FAST_FIRST_NAN
 #undef PCSG_FAST_NO_FIX
 #undef PCSG_FAST_TARGET
 #undef PCSG_FAST_OP
