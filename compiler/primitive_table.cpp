@@ -40,8 +40,12 @@ Box primitiveBox(PrimitiveKind kind, const double* args) {
             return Box{{-inf, -inf, -inf}, {inf, inf, 0}};
         case PrimitiveKind::Empty:
             return Box::empty();
+        // tri1's and tri2's boxes are their corners' (triangleCorners), written out: the
+        // prefill and the unroller ask for one at every triangle they meet.
         case PrimitiveKind::Tri1:
+            return Box{{0, 0, 0}, {1, 1, 0}};
         case PrimitiveKind::Tri2:
+            return Box{{-1, -1, 0}, {0, 0, 0}};
         case PrimitiveKind::Triangle: {
             Vec3 c[3];
             triangleCorners(kind, args, c);

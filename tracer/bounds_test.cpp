@@ -138,6 +138,22 @@ TEST(Bounds, GrowBoxMovesEachFiniteSideByItsRule) {
     EXPECT_TRUE(growBox(Box::empty(), rel, abs).isEmpty());
 }
 
+// tri1's and tri2's boxes, written out in primitiveBox, are the boxes of their corners
+// (triangleCorners) bit for bit.
+TEST(Bounds, TheUnitTrianglesBoxesAreTheirCornersBoxes) {
+    for (PrimitiveKind kind : {PrimitiveKind::Tri1, PrimitiveKind::Tri2}) {
+        Vec3 c[3];
+        triangleCorners(kind, nullptr, c);
+        Box corners;
+        for (const Vec3& p : c) corners.extend(p);
+        const Box b = primitiveBox(kind, nullptr);
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_EQ(std::bit_cast<uint64_t>(b.lo[i]), std::bit_cast<uint64_t>(corners.lo[i]));
+            EXPECT_EQ(std::bit_cast<uint64_t>(b.hi[i]), std::bit_cast<uint64_t>(corners.hi[i]));
+        }
+    }
+}
+
 TEST(Bounds, SierpinskiIsSoundAndTight) {
     auto c = compile(testing::kSierpinski);
     ASSERT_TRUE(c->graph);

@@ -3,7 +3,6 @@
 
 #include <tbb/spin_rw_mutex.h>
 
-#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -180,10 +179,7 @@ class BoxSinkOf {
     static constexpr bool kLocalSelectFrames = true;
     static constexpr bool kCounts = std::is_same_v<R, CountedBoxResult>;
 
-    explicit BoxSinkOf(const InstanceBoxes& boxes) : boxes_(boxes) {
-        for (const PrimitiveInfo& p : kPrimitiveTable)
-            if (p.args == 0) ownBoxes_[static_cast<size_t>(p.kind)] = primitiveBox(p.kind, nullptr);
-    }
+    explicit BoxSinkOf(const InstanceBoxes& boxes) : boxes_(boxes) {}
 
     void reset() {
         visits_ = 0;
@@ -241,9 +237,7 @@ class BoxSinkOf {
         Result r;
         if constexpr (kCounts) r.count = countPrimitive(kind, argc);
         if (kind == PrimitiveKind::Empty) return r;
-        // (A kind without arguments has one box: the terrain's tri1 and tri2, one a leaf.)
-        const Box own = argc == 0 ? ownBoxes_[static_cast<size_t>(kind)] : primitiveBox(kind, args);
-        r.box = transformBox(world, own);
+        r.box = transformBox(world, primitiveBox(kind, args));
         r.weight = 1;
         return r;
     }
@@ -261,8 +255,6 @@ class BoxSinkOf {
 
   private:
     const InstanceBoxes& boxes_;
-    // primitiveBox() of each kind without arguments, computed once.
-    std::array<Box, std::size(kPrimitiveTable)> ownBoxes_;
     uint64_t visits_ = 0;
     bool counted_ = true;
     struct Open {
