@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "bounds.h"
@@ -107,10 +108,10 @@ Result compareWithGraphWalk(const std::string& text, int n, double spread,
         const bool fa = a.firstHit(o[i], d[i], 1e-4, 1e7, ha);
         EXPECT_EQ(b.firstHit(o[i], d[i], 1e-4, 1e7, hb), fa) << "ray " << i;
         EXPECT_EQ(b.anyHit(o[i], d[i], 1e-4, 1e7), fa) << "ray " << i;
-        if (fa) {  // a shadow ray that ends just before the surface
-            EXPECT_EQ(b.anyHit(o[i], d[i], 1e-4, ha.t * (1 - 1e-9)),
-                      a.anyHit(o[i], d[i], 1e-4, ha.t * (1 - 1e-9)))
-                << "ray " << i;
+        if (fa) {  // shadow rays that end just before the surface, at it and just past it
+            for (const double end : {ha.t * (1 - 1e-9), ha.t, std::nextafter(ha.t, 2 * ha.t)})
+                EXPECT_EQ(b.anyHit(o[i], d[i], 1e-4, end), a.anyHit(o[i], d[i], 1e-4, end))
+                    << "ray " << i << " ending at " << end;
         }
         if (!fa) continue;
         ++out.hits;
@@ -226,6 +227,54 @@ TEST(TopLevel, CopiesReferToTheCachesInstanceWhichLivesOnWithTheTopLevel) {
         EXPECT_EQ(after[i].key, before[i].key) << "ray " << i;
     }
     EXPECT_GT(hits, 300u);
+}
+
+// Shadow rays through the copies and their shared instance (which stop at their first
+// surface and leave the hit's key and normal unset): one that ends at the first hit's t
+// meets nothing (a surface at tmax only wins a tie with a hit already found), one that
+// ends a step further meets it, and first hits traced after them are what they were.
+TEST(TopLevel, ShadowRaysThroughCopiesEndAtTheFirstHit) {
+    auto c = compile(testing::sierpinski(5));
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
+    scene.expansionBytes = 256u << 10;  // (the cache expands a level below the top)
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<Vec3> o, d;
+    for (int i = 0; i < 2000; ++i) {
+        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
+        d.push_back(normalize(Vec3{u(rng), u(rng), u(rng) + 0.5} - o.back()));
+    }
+    Tracer warm(scene);
+    SurfaceHit h;
+    for (int round = 0; round < 2; ++round)
+        for (size_t i = 0; i < o.size(); ++i) warm.firstHit(o[i], d[i], 1e-4, 1e7, h);
+    const TopLevel* top = scene.buildTopLevel();
+    ASSERT_TRUE(top);
+    const std::vector<Hit> before = hitsOf(*top, o, d);
+    UnrolledInstance::Scratch scratch;
+    size_t hits = 0;
+    for (size_t i = 0; i < o.size(); ++i) {
+        const LocalRay r{o[i], d[i]};
+        Hit any;
+        double end = 1e7;
+        EXPECT_EQ(top->first(r, 1e-4, end, any, true, scratch), before[i].valid) << "ray " << i;
+        if (!before[i].valid) continue;
+        ++hits;
+        end = before[i].t;
+        EXPECT_FALSE(top->first(r, 1e-4, end, any = Hit{}, true, scratch)) << "ray " << i;
+        end = std::nextafter(before[i].t, 1e7);
+        EXPECT_TRUE(top->first(r, 1e-4, end, any = Hit{}, true, scratch)) << "ray " << i;
+    }
+    EXPECT_GT(hits, 300u);
+    const std::vector<Hit> after = hitsOf(*top, o, d);
+    for (size_t i = 0; i < o.size(); ++i) {
+        ASSERT_EQ(after[i].valid, before[i].valid) << "ray " << i;
+        if (!before[i].valid) continue;
+        EXPECT_EQ(after[i].t, before[i].t) << "ray " << i;
+        EXPECT_EQ(after[i].normal, before[i].normal) << "ray " << i;
+        EXPECT_EQ(after[i].key, before[i].key) << "ray " << i;
+    }
 }
 
 }  // namespace

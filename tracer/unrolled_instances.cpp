@@ -841,7 +841,9 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                 if (!(b->t < tmax) &&
                     !(b->t == tmax && hit.valid && keyOf(node, use.path) < hit.key))
                     break;
-                hit = Hit{b->t, b->normal, material, true, keyOf(node, use.path), paint};
+                // (a shadow ray's hit is only its existence: no key, no normal to map back)
+                hit =
+                    Hit{b->t, b->normal, material, true, anyHit ? 0 : keyOf(node, use.path), paint};
                 tmax = b->t;
                 found = true;
                 break;
@@ -856,7 +858,7 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                                   std::nextafter(tmax, std::numeric_limits<double>::infinity()),
                                   b) &&
                 (b.t < tmax || (b.t == tmax && hit.valid && keyOf(node, use.path) < hit.key))) {
-                hit = Hit{b.t, b.normal, material, true, keyOf(node, use.path), paint};
+                hit = Hit{b.t, b.normal, material, true, anyHit ? 0 : keyOf(node, use.path), paint};
                 tmax = b.t;
                 found = true;
             }
@@ -885,7 +887,7 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                                  use, anyHit, s);
             break;
     }
-    if (found) hit.normal = leave(node, hit.normal);
+    if (found && !anyHit) hit.normal = leave(node, hit.normal);
     return found;
 }
 
@@ -952,10 +954,10 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
             const uint32_t n = p.child & ~kLeaf;
             const LocalRay& rr = p.link == kNone ? r : linkedRay(p.link, r, stamp, s);
             if (firstAt(n, rr, tmin, tmax, hit, use, anyHit, s)) {
+                if (anyHit) return true;
                 for (uint32_t l = p.link; l != kNone; l = links_[l].parent)
                     hit.normal = matrices_[links_[l].matrix].transposedVector(hit.normal);
                 found = true;
-                if (anyHit) return true;
             }
             continue;
         }
