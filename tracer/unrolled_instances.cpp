@@ -947,6 +947,7 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
     const FloatRay fr = floatRay(r, tmin);
 #endif
     bool found = false;
+    uint32_t foundLink = kNone;  // the nearest hit's link: its normal mapped back at the end
     while (top > 0) {
         const Pending p = stack[--top];
         if (p.t0 > tmax) continue;  // (at tmax exactly it may still win a tie)
@@ -955,8 +956,7 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
             const LocalRay& rr = p.link == kNone ? r : linkedRay(p.link, r, stamp, s);
             if (firstAt(n, rr, tmin, tmax, hit, use, anyHit, s)) {
                 if (anyHit) return true;
-                for (uint32_t l = p.link; l != kNone; l = links_[l].parent)
-                    hit.normal = matrices_[links_[l].matrix].transposedVector(hit.normal);
+                foundLink = p.link;
                 found = true;
             }
             continue;
@@ -980,6 +980,9 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
             stack[k] = {b.child[c], b.link[c], t0[c]};
         }
     }
+    // (a nearer hit replaces the whole of hit.normal, so only the last one's is mapped)
+    for (uint32_t l = foundLink; l != kNone; l = links_[l].parent)
+        hit.normal = matrices_[links_[l].matrix].transposedVector(hit.normal);
     return found;
 }
 
