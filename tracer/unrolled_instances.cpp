@@ -816,6 +816,51 @@ size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
     return spansAt(root_, r, tmin, tmax, spans, use, s);
 }
 
+// A solid primitive's first boundary after tmin that is nearer than the hit so far (or at
+// tmax, winning the tie), the ray (o, d) in its frame: its normal left in that frame.
+[[gnu::always_inline]] inline bool UnrolledInstance::firstInSolid(const Node& node, const Vec3& o,
+                                                                  const Vec3& d, double tmin,
+                                                                  double& tmax, Hit& hit,
+                                                                  const Use& use,
+                                                                  bool anyHit) const {
+    SpanRoom room;
+    Span* sp = room.s;
+    const int count = intersectSolid(node.prim, args_.data() + node.first, o, d, sp);
+    for (int k = 0; k < count; ++k) {
+        const Boundary* b =
+            sp[k].in.t > tmin ? &sp[k].in : (sp[k].out.t > tmin ? &sp[k].out : nullptr);
+        if (!b) continue;
+        // (the key is replayed only for a tie or a new nearest hit)
+        if (!(b->t < tmax) && !(b->t == tmax && hit.valid && keyOf(node, use.path) < hit.key))
+            return false;
+        const bool inherit = node.material == kInherit;
+        // (a shadow ray's hit is only its existence: no key, no normal to map back)
+        hit = Hit{b->t,
+                  b->normal,
+                  inherit ? use.material : node.material,
+                  true,
+                  anyHit ? 0 : keyOf(node, use.path),
+                  inherit ? use.paint : 0};
+        tmax = b->t;
+        return true;
+    }
+    return false;
+}
+
+// A solid operand met in a hierarchy (its box there its own), as firstAt would enter it,
+// without firstAt's dispatch and without copying the ray where it has no matrices.
+bool UnrolledInstance::firstSolidLeaf(const Node& node, const LocalRay& r, double tmin,
+                                      double& tmax, Hit& hit, const Use& use, bool anyHit,
+                                      Scratch& s) const {
+    ++s.visits;
+    if (node.matrices == 0) return firstInSolid(node, r.o, r.d, tmin, tmax, hit, use, anyHit);
+    const LocalRay rr =
+        mapRay(matrices_.data(), matrixRefs_.data() + node.firstMatrix, node.matrices, r);
+    if (!firstInSolid(node, rr.o, rr.d, tmin, tmax, hit, use, anyHit)) return false;
+    if (!anyHit) hit.normal = leave(node, hit.normal);
+    return true;
+}
+
 bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit,
                                const Use& use, bool anyHit, Scratch& s) const {
     ++s.visits;
@@ -829,27 +874,9 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
     const uint32_t paint = node.material == kInherit ? use.paint : 0;
     bool found = false;
     switch (node.kind) {
-        case Kind::Solid: {
-            SpanRoom room;
-            Span* sp = room.s;
-            const int count = intersectSolid(node.prim, args_.data() + node.first, rr.o, rr.d, sp);
-            for (int k = 0; k < count; ++k) {
-                const Boundary* b =
-                    sp[k].in.t > tmin ? &sp[k].in : (sp[k].out.t > tmin ? &sp[k].out : nullptr);
-                if (!b) continue;
-                // (the key is replayed only for a tie or a new nearest hit)
-                if (!(b->t < tmax) &&
-                    !(b->t == tmax && hit.valid && keyOf(node, use.path) < hit.key))
-                    break;
-                // (a shadow ray's hit is only its existence: no key, no normal to map back)
-                hit =
-                    Hit{b->t, b->normal, material, true, anyHit ? 0 : keyOf(node, use.path), paint};
-                tmax = b->t;
-                found = true;
-                break;
-            }
+        case Kind::Solid:
+            found = firstInSolid(node, rr.o, rr.d, tmin, tmax, hit, use, anyHit);
             break;
-        }
         case Kind::Triangle: {
             Vec3 corners[3];
             triangleCorners(node.prim, args_.data() + node.first, corners);
@@ -954,7 +981,10 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
         if (p.child & kLeaf) {      // an operand: its box was the child's box
             const uint32_t n = p.child & ~kLeaf;
             const LocalRay& rr = p.link == kNone ? r : linkedRay(p.link, r, stamp, s);
-            if (firstAt(n, rr, tmin, tmax, hit, use, anyHit, s)) {
+            const Node& leaf = nodes_[n];
+            if (leaf.kind == Kind::Solid && !leaf.looseInBvh
+                    ? firstSolidLeaf(leaf, rr, tmin, tmax, hit, use, anyHit, s)
+                    : firstAt(n, rr, tmin, tmax, hit, use, anyHit, s)) {
                 if (anyHit) return true;
                 foundLink = p.link;
                 found = true;
