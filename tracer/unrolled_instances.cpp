@@ -968,17 +968,16 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
     constexpr int kStack = 4 * 32 + 4;
     Pending stack[kStack];
     int top = 0;
-    stack[top++] = {root, kNone, floatBelow(tmin)};
+    Pending p = {root, kNone, floatBelow(tmin)};
+    if (p.t0 > tmax) return false;
     const uint64_t stamp = ++s.stamp;
 #if defined(__SSE2__)
     const FloatRay fr = floatRay(r, tmin);
 #endif
     bool found = false;
     uint32_t foundLink = kNone;  // the nearest hit's link: its normal mapped back at the end
-    while (top > 0) {
-        const Pending p = stack[--top];
-        if (p.t0 > tmax) continue;  // (at tmax exactly it may still win a tie)
-        if (p.child & kLeaf) {      // an operand: its box was the child's box
+    for (;;) {
+        if (p.child & kLeaf) {  // an operand: its box was the child's box
             const uint32_t n = p.child & ~kLeaf;
             const LocalRay& rr = p.link == kNone ? r : linkedRay(p.link, r, stamp, s);
             const Node& leaf = nodes_[n];
@@ -989,26 +988,36 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
                 foundLink = p.link;
                 found = true;
             }
-            continue;
-        }
-        const BvhNode& b = bvh_[p.child];
-        float t0[4];
+        } else {
+            const BvhNode& b = bvh_[p.child];
+            float t0[4];
 #if defined(__SSE2__)
-        int mask =
-            fr.ok ? enterChildrenFloat(b, fr, tmax, t0) : enterChildrenBelow(b, r, tmin, tmax, t0);
+            int mask = fr.ok ? enterChildrenFloat(b, fr, tmax, t0)
+                             : enterChildrenBelow(b, r, tmin, tmax, t0);
 #else
-        int mask = enterChildrenBelow(b, r, tmin, tmax, t0);
+            int mask = enterChildrenBelow(b, r, tmin, tmax, t0);
 #endif
-        // The children met, farthest pushed first (by insertion: at most four) for a first
-        // hit.
-        const int base = top;
-        for (; mask != 0; mask &= mask - 1) {
-            const int c = __builtin_ctz(static_cast<unsigned>(mask));
-            int k = top++;
-            // (a shadow ray may stop at any surface: its children unsorted)
-            for (; !anyHit && k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
-            stack[k] = {b.child[c], b.link[c], t0[c]};
+            // The children met, farthest pushed first (by insertion: at most four) for a
+            // first hit.
+            const int base = top;
+            for (; mask != 0; mask &= mask - 1) {
+                const int c = __builtin_ctz(static_cast<unsigned>(mask));
+                int k = top++;
+                // (a shadow ray may stop at any surface: its children unsorted)
+                for (; !anyHit && k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
+                stack[k] = {b.child[c], b.link[c], t0[c]};
+            }
+            // The nearest child met (on top) next, without the pops' test against tmax: the
+            // node test met it within tmax (widened by at most its margin) and no hit has
+            // moved tmax since; a box entered in vain costs work, never a hit.
+            if (top > base) {
+                p = stack[--top];
+                continue;
+            }
         }
+        while (top > 0 && stack[top - 1].t0 > tmax) --top;  // (at tmax exactly: a tie)
+        if (top == 0) break;
+        p = stack[--top];
     }
     // (a nearer hit replaces the whole of hit.normal, so only the last one's is mapped)
     for (uint32_t l = foundLink; l != kNone; l = links_[l].parent)
