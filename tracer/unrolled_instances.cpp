@@ -847,18 +847,33 @@ size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
     return false;
 }
 
-// A solid operand met in a hierarchy (its box there its own), as firstAt would enter it,
-// without firstAt's dispatch and without copying the ray where it has no matrices.
-bool UnrolledInstance::firstSolidLeaf(const Node& node, const LocalRay& r, double tmin,
-                                      double& tmax, Hit& hit, const Use& use, bool anyHit,
-                                      Scratch& s) const {
+// A solid or an Instance node met in a hierarchy (its box there its own), as firstAt would
+// enter it, without firstAt's dispatch, and a solid without matrices without a copy of the
+// ray.
+bool UnrolledInstance::firstLeaf(const Node& node, const LocalRay& r, double tmin, double& tmax,
+                                 Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
     ++s.visits;
-    if (node.matrices == 0) return firstInSolid(node, r.o, r.d, tmin, tmax, hit, use, anyHit);
+    const bool solid = node.kind == Kind::Solid;
+    if (solid && node.matrices == 0)
+        return firstInSolid(node, r.o, r.d, tmin, tmax, hit, use, anyHit);
+    // (a copy all the same for an instance: its walk may reuse the slot of r's link)
     const LocalRay rr =
-        mapRay(matrices_.data(), matrixRefs_.data() + node.firstMatrix, node.matrices, r);
-    if (!firstInSolid(node, rr.o, rr.d, tmin, tmax, hit, use, anyHit)) return false;
-    if (!anyHit) hit.normal = leave(node, hit.normal);
-    return true;
+        node.matrices == 0
+            ? r
+            : mapRay(matrices_.data(), matrixRefs_.data() + node.firstMatrix, node.matrices, r);
+    bool found;
+    if (solid) {
+        found = firstInSolid(node, rr.o, rr.d, tmin, tmax, hit, use, anyHit);
+    } else {
+        const bool inherit = node.material == kInherit;
+        const Reference& x = instances_[node.first];
+        found = firstInInstance(
+            x, rr, tmin, tmax, hit,
+            Use{x.path, inherit ? use.material : node.material, inherit ? use.paint : 0}, anyHit,
+            s);
+    }
+    if (found && !anyHit) hit.normal = leave(node, hit.normal);
+    return found;
 }
 
 bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit,
@@ -981,8 +996,8 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
             const uint32_t n = p.child & ~kLeaf;
             const LocalRay& rr = p.link == kNone ? r : linkedRay(p.link, r, stamp, s);
             const Node& leaf = nodes_[n];
-            if (leaf.kind == Kind::Solid && !leaf.looseInBvh
-                    ? firstSolidLeaf(leaf, rr, tmin, tmax, hit, use, anyHit, s)
+            if (!leaf.looseInBvh && (leaf.kind == Kind::Solid || leaf.kind == Kind::Instance)
+                    ? firstLeaf(leaf, rr, tmin, tmax, hit, use, anyHit, s)
                     : firstAt(n, rr, tmin, tmax, hit, use, anyHit, s)) {
                 if (anyHit) return true;
                 foundLink = p.link;

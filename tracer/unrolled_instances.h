@@ -191,8 +191,8 @@ class UnrolledInstance {
     const LocalRay& linkedRay(uint32_t l, const LocalRay& r, uint64_t stamp, Scratch& s) const;
     bool firstInSolid(const Node& node, const Vec3& o, const Vec3& d, double tmin, double& tmax,
                       Hit& hit, const Use& use, bool anyHit) const;
-    bool firstSolidLeaf(const Node& node, const LocalRay& r, double tmin, double& tmax, Hit& hit,
-                        const Use& use, bool anyHit, Scratch& s) const;
+    bool firstLeaf(const Node& node, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                   const Use& use, bool anyHit, Scratch& s) const;
     bool firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax, Hit& hit,
                   const Use& use, bool anyHit, Scratch& s) const;
     LocalRay enter(const Node& node, const LocalRay& r) const;
