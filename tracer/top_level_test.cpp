@@ -177,6 +177,16 @@ TEST(TopLevel, ADifferenceAboveTheInstancesFallsBackToTheWalk) {
     EXPECT_GT(r.hits, 300u);
 }
 
+// n random rays (origins o, directions d) from in front of the scene towards its middle.
+void fan(uint64_t seed, int n, std::vector<Vec3>& o, std::vector<Vec3>& d) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int i = 0; i < n; ++i) {
+        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
+        d.push_back(normalize(Vec3{u(rng), u(rng), u(rng) + 0.5} - o.back()));
+    }
+}
+
 // The first hits of rays from the origins o in the directions d through the top level alone.
 std::vector<Hit> hitsOf(const TopLevel& top, const std::vector<Vec3>& o,
                         const std::vector<Vec3>& d) {
@@ -195,13 +205,8 @@ TEST(TopLevel, CopiesReferToTheCachesInstanceWhichLivesOnWithTheTopLevel) {
     auto scene =
         std::make_unique<TraceScene>(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
     scene->expansionBytes = 256u << 10;  // (the cache expands a level below the top)
-    std::mt19937_64 rng(5);
-    std::uniform_real_distribution<double> u(-1, 1);
     std::vector<Vec3> o, d;
-    for (int i = 0; i < 2000; ++i) {
-        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
-        d.push_back(normalize(Vec3{u(rng), u(rng), u(rng) + 0.5} - o.back()));
-    }
+    fan(5, 2000, o, d);
     {
         Tracer warm(*scene);
         SurfaceHit h;
@@ -238,13 +243,8 @@ TEST(TopLevel, ShadowRaysThroughCopiesEndAtTheFirstHit) {
     ASSERT_TRUE(c->graph);
     TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
     scene.expansionBytes = 256u << 10;  // (the cache expands a level below the top)
-    std::mt19937_64 rng(17);
-    std::uniform_real_distribution<double> u(-1, 1);
     std::vector<Vec3> o, d;
-    for (int i = 0; i < 2000; ++i) {
-        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
-        d.push_back(normalize(Vec3{u(rng), u(rng), u(rng) + 0.5} - o.back()));
-    }
+    fan(17, 2000, o, d);
     Tracer warm(scene);
     SurfaceHit h;
     for (int round = 0; round < 2; ++round)
