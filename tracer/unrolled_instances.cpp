@@ -966,18 +966,39 @@ bool UnrolledInstance::firstOfNodes(const uint32_t* list, uint32_t count, const 
         });
 }
 
+namespace {
+
+// A child of a BVH node that firstBvh has still to visit (its entry in floats: the float
+// test's own, or the doubles' rounded down, so that it is never later than the doubles';
+// 16 bytes, moved as one).
+struct alignas(16) Pending {
+    uint32_t child, link;
+    float t0;
+};
+
+// Pushes the children of b in `mask`, entered at t0[c], onto stack[top..]; returns the new
+// top. For a first hit sorted, the farthest first (by insertion: at most four), so that the
+// nearest is on top; a shadow ray may stop at any surface, so its children go unsorted.
+[[gnu::always_inline]] inline int pushMet(const UnrolledInstance::BvhNode& b, int mask,
+                                          const float t0[4], bool sorted, Pending* stack, int top) {
+    const int base = top;
+    for (; mask != 0; mask &= mask - 1) {
+        const int c = __builtin_ctz(static_cast<unsigned>(mask));
+        int k = top++;
+        for (; sorted && k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
+        stack[k] = {b.child[c], b.link[c], t0[c]};
+    }
+    return top;
+}
+
+}  // namespace
+
 // The first hit in a union's BVH: the nodes front to back by the ray's entry into them
 // (a stack of the ones still to visit, nearer ones on top), each skipped once its entry
 // lies beyond the nearest hit so far. (The order only saves work: a hit is the nearest
 // (t, key) of all operands whose boxes the ray meets before it, whatever the order.)
 bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, double& tmax,
                                 Hit& hit, const Use& use, bool anyHit, Scratch& s) const {
-    // (the entries in floats: the float test's own, and the doubles' rounded down, so
-    // that an entry is never later than the doubles'; 16 bytes, moved as one)
-    struct alignas(16) Pending {
-        uint32_t child, link;
-        float t0;
-    };
     // Deeper than any hierarchy of median splits, or of a derivation's nesting (hierarchy():
     // at most one level deeper), with four entries per level at most.
     constexpr int kStack = 4 * 32 + 4;
@@ -1012,16 +1033,8 @@ bool UnrolledInstance::firstBvh(uint32_t root, const LocalRay& r, double tmin, d
 #else
             int mask = enterChildrenBelow(b, r, tmin, tmax, t0);
 #endif
-            // The children met, farthest pushed first (by insertion: at most four) for a
-            // first hit.
             const int base = top;
-            for (; mask != 0; mask &= mask - 1) {
-                const int c = __builtin_ctz(static_cast<unsigned>(mask));
-                int k = top++;
-                // (a shadow ray may stop at any surface: its children unsorted)
-                for (; !anyHit && k > base && stack[k - 1].t0 < t0[c]; --k) stack[k] = stack[k - 1];
-                stack[k] = {b.child[c], b.link[c], t0[c]};
-            }
+            top = pushMet(b, mask, t0, !anyHit, stack, top);
             // The nearest child met (on top) next, without the pops' test against tmax: the
             // node test met it within tmax (widened by at most its margin) and no hit has
             // moved tmax since; a box entered in vain costs work, never a hit.
