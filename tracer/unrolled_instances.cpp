@@ -7,6 +7,7 @@
 #include <cstring>
 #include <exception>
 #include <limits>
+#include <new>
 #include <type_traits>
 
 #include "bounds.h"
@@ -275,11 +276,13 @@ class Unroller {
         }
         if (st.inverse) pending_.push_back(inverseIndex(n, *st.inverse));
         // (from the identity: the step's own matrix where that is exact, Semantics' rule)
+        // (the product made in the room itself: assigned, it was made on the stack and
+        // copied in, 24 instructions a T-step)
         AffineRoom composed;
         const Affine* next = edge;
         if (st.forward)
-            next =
-                edge ? &(composed.m = *edge * *st.forward) : &sem_.fromIdentity(n, st, composed.m);
+            next = edge ? new (&composed.m) Affine(*edge * *st.forward)
+                        : &sem_.fromIdentity(n, st, composed.m);
         const uint32_t r = build(st.child, st.state, pendingBase, next);
         if (st.inverse) pending_.pop_back();
         if (kind == NodeKind::Select) choices_.pop_back();
@@ -433,11 +436,11 @@ class Unroller {
     // the derivation gives them (in binary_): each nested union's parts paired up.
     Part collect(uint32_t u, const Affine& toU, uint32_t link, uint32_t length,
                  std::vector<Item>& items) {
-        const Node un = out_.nodes_[u];
+        const uint32_t first = out_.nodes_[u].first, count = out_.nodes_[u].count;
         const size_t base = parts_.size();
         const bool loose = link != kNone && !scaledPermutation(toU);  // (the same for all)
-        for (uint32_t i = 0; i < un.count; ++i) {
-            const uint32_t c = out_.children_[un.first + i];
+        for (uint32_t i = 0; i < count; ++i) {
+            const uint32_t c = out_.children_[first + i];
             const Node& child = out_.nodes_[c];
             if (child.box.isEmpty()) continue;  // holds nothing a ray can hit
             if (isUnion(child) && length + child.matrices <= kMaxChain) {
@@ -527,7 +530,9 @@ class Unroller {
             out_.nodes_[n].bvh = collapse(root);
             out_.bvhLeaves_ += static_cast<uint32_t>(items.size());
         }
-        for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
+        // The unions beyond the chain limit (a call per leaf only tested that).
+        for (const Item& item : items)
+            if (isUnion(out_.nodes_[item.node])) hierarchy(item.node);
     }
 
     // A node of the binary hierarchy that collapse() turns into four-wide nodes: child c
