@@ -7,7 +7,6 @@
 #include <cstring>
 #include <exception>
 #include <limits>
-#include <new>
 #include <type_traits>
 
 #include "bounds.h"
@@ -316,13 +315,11 @@ class Unroller {
         }
         if (st.inverse) pending_.push_back(inverseIndex(n, *st.inverse));
         // (from the identity: the step's own matrix where that is exact, Semantics' rule)
-        // (the product made in the room itself: assigned, it was made on the stack and
-        // copied in, 24 instructions a T-step)
         AffineRoom composed;
         const Affine* next = edge;
         if (st.forward)
-            next = edge ? new (&composed.m) Affine(*edge * *st.forward)
-                        : &sem_.fromIdentity(n, st, composed.m);
+            next =
+                edge ? &(composed.m = *edge * *st.forward) : &sem_.fromIdentity(n, st, composed.m);
         const uint32_t r = build(st.child, st.state, pendingBase, next);
         if (st.inverse) pending_.pop_back();
         if (kind == NodeKind::Select) choices_.pop_back();
