@@ -478,6 +478,7 @@ class Unroller {
                 if (inner.child != kNone) parts_.push_back(inner);
                 continue;
             }
+            if (isUnion(child)) ++beyondChain_;  // (an operand here: a hierarchy of its own)
             const Box box =
                 link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
             out_.nodes_[c].looseInBvh = loose;
@@ -542,6 +543,7 @@ class Unroller {
     void hierarchy(uint32_t n) {
         if (!isUnion(out_.nodes_[n])) return;
         const size_t begin = items_.size();  // (its operands: items_[begin, end))
+        const uint32_t beyond = beyondChain_;
         binary_.clear();
         const Part derived = collect(n, Affine::identity(), kNone, 0, items_);
         const size_t end = items_.size();
@@ -555,9 +557,11 @@ class Unroller {
             out_.nodes_[n].bvh = collapse(root);
             out_.bvhLeaves_ += static_cast<uint32_t>(end - begin);
         }
-        // The unions beyond the chain limit (a call per leaf only tested that).
-        for (size_t k = begin; k < end; ++k)
-            if (isUnion(out_.nodes_[items_[k].node])) hierarchy(items_[k].node);
+        // The unions beyond the chain limit, if collect() met any (a call per leaf, then a
+        // test per leaf, only looked for them).
+        if (beyondChain_ != beyond)
+            for (size_t k = begin; k < end; ++k)
+                if (isUnion(out_.nodes_[items_[k].node])) hierarchy(items_[k].node);
         items_.resize(begin);
     }
 
@@ -702,7 +706,8 @@ class Unroller {
     };
     InverseSlot inverses_[kInverseSlots];
     std::vector<uint32_t> choices_;
-    FlatIndex linkIndex_;  // linkTo()'s links by (parent, matrix)
+    FlatIndex linkIndex_;       // linkTo()'s links by (parent, matrix)
+    uint32_t beyondChain_ = 0;  // unions collect() left as operands (beyond kMaxChain)
     // (the thread's, while it lends its arrays)
     BuildArrays::Stacks stacks_;
     std::vector<uint32_t>& kids_ = stacks_.kids;
