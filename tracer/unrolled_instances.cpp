@@ -53,6 +53,42 @@ struct BuildArrays {
     std::vector<UnrolledInstance::Link> links;
     // The unroller's indices of the matrices and links (kept, emptied, with their slots).
     FlatIndex matrixIndex, linkIndex;
+
+    // The unroller's stacks: they are empty between its steps, so that what a thread keeps
+    // of them is their room (its expansions' hierarchies had grown them from nothing, a
+    // dozen allocations and copies each).
+    struct Stacks {
+        // An operand of a union's BVH: the node, the chain of matrices (links_) from the
+        // union's frame into the frame of the node's own union (kNone: the same frame), and
+        // its box in the union's frame.
+        struct Item {
+            uint32_t node, link;
+            Box box;
+        };
+        // A part of a union's hierarchy as its derivation nests it: an operand (kLeaf,
+        // entered through `link`) or a node of `binary`, with its box and the binary
+        // levels below it (child kNone: nothing).
+        struct Part {
+            uint32_t child = kNone, link = kNone;
+            Box box;
+            uint32_t height = 0;
+        };
+        // A node of the binary hierarchy that collapse() turns into four-wide nodes: child
+        // c is another binary node or (kLeaf) an operand, as in BvhNode.
+        struct Binary {
+            Box box[2];
+            uint32_t child[2], link[2];
+        };
+        std::vector<uint32_t> kids;  // operands of the operators being built
+        std::vector<Item> items;     // the operands of the BVHs being built
+        std::vector<Part> parts;     // collect()'s parts of the unions being collected
+        std::vector<Binary> binary;  // the hierarchy being built
+
+        template <class F>
+        void each(F&& f) {
+            f(kids), f(items), f(parts), f(binary);
+        }
+    } stacks;
     bool lent = false;
 };
 
@@ -169,6 +205,8 @@ class Unroller {
             });
             std::swap(u_.matrixIndex_, b_.matrixIndex);
             std::swap(u_.linkIndex_, b_.linkIndex);
+            b_.stacks.each([](auto& v) { v.clear(); });  // (a build that threw left some)
+            std::swap(u_.stacks_, b_.stacks);
         }
         ~Lent() {
             if (!mine_) {
@@ -185,6 +223,8 @@ class Unroller {
             std::swap(u_.linkIndex_, b_.linkIndex);
             giveBack(b_.matrixIndex, keep_);
             giveBack(b_.linkIndex, keep_);
+            std::swap(u_.stacks_, b_.stacks);
+            b_.stacks.each([keep = keep_](auto& v) { giveBack(v, 0, keep); });  // (<= 64 KB)
             b_.lent = false;
         }
         Lent(const Lent&) = delete;
@@ -408,22 +448,9 @@ class Unroller {
     // Unions of this many operands (after flattening) or fewer get no BVH.
     static constexpr size_t kFewItems = 4;
 
-    // An operand of a union's BVH: the node, the chain of matrices (links_) from the
-    // union's frame into the frame of the node's own union (kNone: the same frame), and its
-    // box in the union's frame.
-    struct Item {
-        uint32_t node, link;
-        Box box;
-    };
-
-    // A part of a union's hierarchy as its derivation nests it: an operand (kLeaf, entered
-    // through `link`) or a node of binary_, with its box and the binary levels below it
-    // (child kNone: nothing).
-    struct Part {
-        uint32_t child = kNone, link = kNone;
-        Box box;
-        uint32_t height = 0;
-    };
+    using Item = BuildArrays::Stacks::Item;
+    using Part = BuildArrays::Stacks::Part;
+    using Binary = BuildArrays::Stacks::Binary;
 
     // The operands of union u and of the unions nested in it, each entered from u's frame
     // through the chain of matrices of the unions on its way (`link`, a path in the tree
@@ -433,11 +460,11 @@ class Unroller {
     // the derivation gives them (in binary_): each nested union's parts paired up.
     Part collect(uint32_t u, const Affine& toU, uint32_t link, uint32_t length,
                  std::vector<Item>& items) {
-        const Node un = out_.nodes_[u];
+        const uint32_t first = out_.nodes_[u].first, count = out_.nodes_[u].count;
         const size_t base = parts_.size();
         const bool loose = link != kNone && !scaledPermutation(toU);  // (the same for all)
-        for (uint32_t i = 0; i < un.count; ++i) {
-            const uint32_t c = out_.children_[un.first + i];
+        for (uint32_t i = 0; i < count; ++i) {
+            const uint32_t c = out_.children_[first + i];
             const Node& child = out_.nodes_[c];
             if (child.box.isEmpty()) continue;  // holds nothing a ray can hit
             if (isUnion(child) && length + child.matrices <= kMaxChain) {
@@ -451,6 +478,7 @@ class Unroller {
                 if (inner.child != kNone) parts_.push_back(inner);
                 continue;
             }
+            if (isUnion(child)) ++beyondChain_;  // (an operand here: a hierarchy of its own)
             const Box box =
                 link == kNone ? child.box : growBox(transformBox(toU, child.box), 1e-7, 1e-9);
             out_.nodes_[c].looseInBvh = loose;
@@ -514,28 +542,28 @@ class Unroller {
     // without sorting; otherwise (a flower's chain of petals) median splits make it.
     void hierarchy(uint32_t n) {
         if (!isUnion(out_.nodes_[n])) return;
-        std::vector<Item> items;
+        const size_t begin = items_.size();  // (its operands: items_[begin, end))
+        const uint32_t beyond = beyondChain_;
         binary_.clear();
-        const Part derived = collect(n, Affine::identity(), kNone, 0, items);
-        if (items.size() > kFewItems) {  // (else the union's own operands will do)
-            const uint32_t balanced = std::bit_width(items.size() - 1) + 1;
+        const Part derived = collect(n, Affine::identity(), kNone, 0, items_);
+        const size_t end = items_.size();
+        if (end - begin > kFewItems) {  // (else the union's own operands will do)
+            const uint32_t balanced = std::bit_width(end - begin - 1) + 1;
             uint32_t root = derived.child;
             if (derived.height > balanced) {
                 binary_.clear();
-                root = split(items, 0, items.size());
+                root = split(items_, begin, end);
             }
             out_.nodes_[n].bvh = collapse(root);
-            out_.bvhLeaves_ += static_cast<uint32_t>(items.size());
+            out_.bvhLeaves_ += static_cast<uint32_t>(end - begin);
         }
-        for (const Item& item : items) hierarchy(item.node);  // unions beyond the chain limit
+        // The unions beyond the chain limit, if collect() met any (a call per leaf, then a
+        // test per leaf, only looked for them).
+        if (beyondChain_ != beyond)
+            for (size_t k = begin; k < end; ++k)
+                if (isUnion(out_.nodes_[items_[k].node])) hierarchy(items_[k].node);
+        items_.resize(begin);
     }
-
-    // A node of the binary hierarchy that collapse() turns into four-wide nodes: child c
-    // is another binary node or (kLeaf) an operand, as in BvhNode.
-    struct Binary {
-        Box box[2];
-        uint32_t child[2], link[2];
-    };
 
     // The binary hierarchy over items[begin, end) (two or more), in binary_: halves at the
     // median of the items' centres along the axis where the centres spread widest. Returns
@@ -678,10 +706,14 @@ class Unroller {
     };
     InverseSlot inverses_[kInverseSlots];
     std::vector<uint32_t> choices_;
-    std::vector<uint32_t> kids_;  // operands of the operators being built
-    FlatIndex linkIndex_;         // linkTo()'s links by (parent, matrix)
-    std::vector<Binary> binary_;  // the hierarchy being built
-    std::vector<Part> parts_;     // collect()'s parts of the unions being collected
+    FlatIndex linkIndex_;       // linkTo()'s links by (parent, matrix)
+    uint32_t beyondChain_ = 0;  // unions collect() left as operands (beyond kMaxChain)
+    // (the thread's, while it lends its arrays)
+    BuildArrays::Stacks stacks_;
+    std::vector<uint32_t>& kids_ = stacks_.kids;
+    std::vector<Item>& items_ = stacks_.items;
+    std::vector<Part>& parts_ = stacks_.parts;
+    std::vector<Binary>& binary_ = stacks_.binary;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -1127,6 +1159,7 @@ size_t UnrolledInstance::keptBuildBytes() {
     };
     add(b.nodes), add(b.children), add(b.matrixRefs), add(b.choices);
     add(b.matrices), add(b.args), add(b.bvh), add(b.links);
+    b.stacks.each(add);
     return bytes + b.matrixIndex.bytes() + b.linkIndex.bytes();
 }
 

@@ -519,6 +519,31 @@ TEST(ExpandedInstances, UnionsBelowLongChainsOfMatricesAreOneHierarchy) {
     EXPECT_GT(compareWithGraphWalk(kDeepChains, 1.5, 100), 0u);
 }
 
+// A chain of unions 14 levels deep, each level four small spheres and, first, the next
+// level entered through four matrices (parametric: not fused): 56 matrices from the root
+// to the deepest, so the root's hierarchy takes levels 0 to 8 (32 matrices: 36 spheres
+// and the union of level 9 as one operand) and the union of level 9 gets a hierarchy of
+// its own (levels 9 to 13: 20 spheres and the last level's one), built while the root's
+// operands are still being gone through (the unroller keeps them all on one stack).
+const char* kLongChain = R"(
+{n = 14; a = 20} T
+T if(n > 0, 2, 1)
+1: T -> uscale(0.3) sphere
+2: T -> {n = n-1; a = a*0.9}
+        (move(0.3, 0, 0.4) rotz(a) rotx(a*0.5) uscale(0.9) T ∪ move(0.5, 0, 0) uscale(0.2) sphere
+         ∪ move(0, 0.5, 0) uscale(0.2) sphere ∪ move(-0.5, 0, 0) uscale(0.2) sphere
+         ∪ move(0, -0.5, 0) uscale(0.2) sphere)
+)";
+
+TEST(ExpandedInstances, AUnionBeyondTheChainLimitGetsAHierarchyOfItsOwn) {
+    const auto x = expandAxiom(kLongChain);
+    ASSERT_TRUE(x);
+    size_t all = 0;
+    for (const std::vector<uint32_t>& group : x->bvhLeafGroups()) all += group.size();
+    EXPECT_EQ(all, 37u + 21u);
+    EXPECT_GT(compareWithGraphWalk(kLongChain, 1.5, 100), 0u);
+}
+
 // Operands of a hierarchy whose box there is a box of their box through rotations test
 // their own box before they are entered (the spheres below kDeepChains' rotations);
 // below moves and scales (Sierpinski) the two are the same box, and none does.
