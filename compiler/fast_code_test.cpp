@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 
 #include "compile_test_util.h"
 #include "eval.h"
@@ -487,6 +489,42 @@ TEST(FastCode, FusedRunsReportUnassignedReadsAsThePlainCodeDoes) {
         EXPECT_NE(fast.find("'w'"), std::string::npos) << exprs[i] << ": " << fast;
         EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
     }
+}
+
+TEST(FastCode, RecalledRandLnChainsAreKeyedByTheirSeedAndConstants) {
+    // Three rnd chains of the same sd with other constants, in a graph and in its copy with
+    // another seed: each run recalls (a few values of x, many times) only what the same
+    // seed and constants gave, bit for bit the plain code's value.
+    auto c = withExprs({"((-ln(rand(x)*0.75+1.0))+0.125)*z", "((-ln(rand(x)*0.5+1.0))+0.125)*z",
+                        "((-ln(rand(x)*0.75+2.0))+0.125)*z"});
+    ASSERT_TRUE(c->graph);
+    Graph other = *c->graph;
+    other.scene.settings.seed = c->graph->scene.settings.seed + 1;
+    const Graph* graphs[] = {&*c->graph, &other};
+    const Graph plains[] = {plainOf(*c->graph), plainOf(other)};
+    const NodeId node = calcNodeUnderTest(other);
+    const auto slotOf = [&](const char* name) {
+        return static_cast<Slot>(std::find(other.slotNames.begin(), other.slotNames.end(), name) -
+                                 other.slotNames.begin());
+    };
+    const Slot x = slotOf("x"), z = slotOf("z");
+    std::vector<double> frame, fast(other.slotCount()), slow(other.slotCount());
+    std::set<uint64_t> values;
+    for (int k = 0; k < 600; ++k) {
+        const Graph& g = *graphs[k % 2];
+        frame.assign(g.slotCount(), 0);
+        initFrame(g, frame.data());
+        frame[x] = 0.5 * (k / 2 % 5) - 1, frame[z] = 1.5;
+        const EvalState s{frame.data(), kRootPath};
+        applyCalc(g, node, s, fast.data());
+        applyCalc(plains[k % 2], node, s, slow.data());
+        for (Slot i = 0; i < g.slotCount(); ++i)
+            ASSERT_EQ(std::bit_cast<uint64_t>(fast[i]), std::bit_cast<uint64_t>(slow[i]))
+                << g.slotNames[i] << " of graph " << k % 2 << " with x = " << frame[x];
+        for (const char* r : {"r1", "r2", "r3"})
+            values.insert(std::bit_cast<uint64_t>(fast[slotOf(r)]));
+    }
+    EXPECT_EQ(values.size(), 2u * 5u * 3u);  // each seed, x and chain its own value
 }
 
 TEST(FastCode, TwoLeavesAndTheirOperatorStoreWithoutTheStoresDispatch) {

@@ -7,6 +7,7 @@
 
 #include "eval.h"
 #include "eval_core.h"
+#include "eval_recall.h"
 
 namespace pcsg {
 
@@ -26,6 +27,22 @@ inline double addFirstNan(double a, double b) {
 inline double mulFirstNan(double a, double b) {
     const double r = a * b;
     return r != r && a != a ? a * a : r;
+}
+
+// The rnd chain's first four operations, ln(rand(sd)*k1 + k2), as Rand1, MulK, AddK and Ln
+// compute them (Ln's lnRecalled gives std::log's bits; its table is not consulted here,
+// where the chain's own table below missed).
+double randLnComputed(double sd, double seedBits, double k1, double k2) {
+    const double u = randOfInline(std::bit_cast<uint64_t>(seedBits), sd);
+    return std::log(addFirstNan(mulFirstNan(u, k1), k2));
+}
+
+// The same, recalled by the bits of sd, the seed, k1 and k2 (slots chosen by sd's alone):
+// the two triangles at an edge, and every expansion of them, seed the same rnd. A hit skips
+// rand()'s three mixes and the logarithm's own recall.
+inline double randLnRecalled(uint64_t seed, double sd, double k1, double k2) {
+    thread_local Recall<4, double (*)(double, double, double, double), 1> memo(randLnComputed);
+    return memo({sd, std::bit_cast<double>(seed), k1, k2});
 }
 }  // namespace
 
@@ -133,42 +150,41 @@ inline double mulFirstNan(double a, double b) {
 // operands, each operation as its own instruction computes it (an unassigned read stops
 // the run; nothing is stored before it, so stopping earlier or later gives the same), then
 // pc skips the run (and does the store after it).
-#define PCSG_FAST_FUSED_RUNS                                                            \
-    PCSG_FAST_ADD_MUL_KL                                                                \
-    PCSG_FAST_OP(SumMulKL4) {                                                           \
-        const double x0 = frame[in[0].a], x1 = frame[in[1].a];                          \
-        const double x2 = frame[in[2].a], x3 = frame[in[3].a];                          \
-        if (unassignedBits(x0) || unassignedBits(x1)) return false;                     \
-        if (unassignedBits(x2) || unassignedBits(x3)) return false;                     \
-        st[sp++] = acc;                                                                 \
-        acc = mulFirstNan(in[0].imm, x0);                                               \
-        acc = addFirstNan(acc, mulFirstNan(in[1].imm, x1));                             \
-        acc = addFirstNan(acc, mulFirstNan(in[2].imm, x2));                             \
-        acc = addFirstNan(acc, mulFirstNan(in[3].imm, x3));                             \
-        pc += 3;                                                                        \
-        PCSG_FAST_THEN_STORE                                                            \
-    }                                                                                   \
-    PCSG_FAST_NEXT;                                                                     \
-    PCSG_FAST_OP(RandLnChain) {                                                         \
-        const double x = frame[in[6].a];                                                \
-        if (unassignedBits(x)) return false;                                            \
-        const double u = randOfInline(seed, acc);                                       \
-        const double l = lnRecalled(addFirstNan(mulFirstNan(u, in[1].imm), in[2].imm)); \
-        acc = mulFirstNan(addFirstNan(-l, in[5].imm), x);                               \
-        pc += 6;                                                                        \
-        PCSG_FAST_THEN_STORE                                                            \
-    }                                                                                   \
-    PCSG_FAST_NEXT;                                                                     \
-    PCSG_FAST_OP(MeanAddL) {                                                            \
-        const double a = frame[in[0].a], b = frame[in[0].b];                            \
-        const double c = frame[in[2].a];                                                \
-        if (unassignedBits(a) || unassignedBits(b)) return false;                       \
-        if (unassignedBits(c)) return false;                                            \
-        st[sp++] = acc;                                                                 \
-        acc = addFirstNan(addFirstNan(a, b) / in[1].imm, c);                            \
-        pc += 2;                                                                        \
-        PCSG_FAST_THEN_STORE                                                            \
-    }                                                                                   \
+#define PCSG_FAST_FUSED_RUNS                                              \
+    PCSG_FAST_ADD_MUL_KL                                                  \
+    PCSG_FAST_OP(SumMulKL4) {                                             \
+        const double x0 = frame[in[0].a], x1 = frame[in[1].a];            \
+        const double x2 = frame[in[2].a], x3 = frame[in[3].a];            \
+        if (unassignedBits(x0) || unassignedBits(x1)) return false;       \
+        if (unassignedBits(x2) || unassignedBits(x3)) return false;       \
+        st[sp++] = acc;                                                   \
+        acc = mulFirstNan(in[0].imm, x0);                                 \
+        acc = addFirstNan(acc, mulFirstNan(in[1].imm, x1));               \
+        acc = addFirstNan(acc, mulFirstNan(in[2].imm, x2));               \
+        acc = addFirstNan(acc, mulFirstNan(in[3].imm, x3));               \
+        pc += 3;                                                          \
+        PCSG_FAST_THEN_STORE                                              \
+    }                                                                     \
+    PCSG_FAST_NEXT;                                                       \
+    PCSG_FAST_OP(RandLnChain) {                                           \
+        const double x = frame[in[6].a];                                  \
+        if (unassignedBits(x)) return false;                              \
+        const double l = randLnRecalled(seed, acc, in[1].imm, in[2].imm); \
+        acc = mulFirstNan(addFirstNan(-l, in[5].imm), x);                 \
+        pc += 6;                                                          \
+        PCSG_FAST_THEN_STORE                                              \
+    }                                                                     \
+    PCSG_FAST_NEXT;                                                       \
+    PCSG_FAST_OP(MeanAddL) {                                              \
+        const double a = frame[in[0].a], b = frame[in[0].b];              \
+        const double c = frame[in[2].a];                                  \
+        if (unassignedBits(a) || unassignedBits(b)) return false;         \
+        if (unassignedBits(c)) return false;                              \
+        st[sp++] = acc;                                                   \
+        acc = addFirstNan(addFirstNan(a, b) / in[1].imm, c);              \
+        pc += 2;                                                          \
+        PCSG_FAST_THEN_STORE                                              \
+    }                                                                     \
     PCSG_FAST_NEXT;
 #define PCSG_FAST_NO_FIX (void)0
 #define PCSG_FAST_PUSH(OP, EXPR) \
