@@ -463,6 +463,48 @@ TEST(FastCode, FusedRunsGiveTheBitsOfTheirInstructionsOneByOne) {
     }
 }
 
+TEST(FastCode, FusedRunsGiveTheBitsOfTheirInstructionsWithNansOfEverySignAndPayload) {
+    // The fused runs compute their value plainly and only a NaN again with each
+    // instruction's fix: operands that are NaNs of other signs and payloads, two or more in
+    // one run, give the bits of the runs' instructions one by one.
+    auto c = withExprs({"2.5*x + 3*y + 0.5*z + 7*x", "((-ln(rand(x)*0.75+1.0))+0.125)*y",
+                        "(x+y)/2.0 + z", "(z+x)/2.0 + y"});
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Graph unfused = unfusedOf(g);
+    const std::string dump = dumpFastCalc(g, calcUnderTest(g));
+    for (const char* form : {"SumMulKL4", "RandLnChain", "MeanAddL x y", "MeanAddL z x"})
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+    const double nans[] = {std::bit_cast<double>(0x7ff8000000000001ull),
+                           std::bit_cast<double>(0xfff8000000000002ull),
+                           std::bit_cast<double>(0x7ff0000000000003ull),  // signalling
+                           std::bit_cast<double>(0xfff800000000abcdull)};
+    const double values[] = {nans[0], nans[1], nans[2], nans[3], 1.5, -2, kInf, -kInf, 0};
+    const NodeId node = calcNodeUnderTest(g);
+    std::vector<double> frame, fused(g.slotCount()), oneByOne(g.slotCount());
+    int nanValues = 0;
+    for (double x : values)
+        for (double y : values)
+            for (double z : values) {
+                frame.assign(g.slotCount(), 0);
+                initFrame(g, frame.data());
+                for (Slot s = 0; s < g.slotCount(); ++s)
+                    if (g.slotNames[s] == "x" || g.slotNames[s] == "y" || g.slotNames[s] == "z")
+                        frame[s] = g.slotNames[s] == "x" ? x : g.slotNames[s] == "y" ? y : z;
+                const EvalState s{frame.data(), kRootPath};
+                applyCalc(g, node, s, fused.data());
+                applyCalc(unfused, node, s, oneByOne.data());
+                for (Slot i = 0; i < g.slotCount(); ++i) {
+                    ASSERT_EQ(std::bit_cast<uint64_t>(fused[i]),
+                              std::bit_cast<uint64_t>(oneByOne[i]))
+                        << g.slotNames[i] << " with " << describeFrame(g, frame.data()) << "\n"
+                        << dump;
+                    nanValues += std::isnan(fused[i]);
+                }
+            }
+    EXPECT_GT(nanValues, 1000);
+}
+
 TEST(FastCode, FusedRunsReportUnassignedReadsAsThePlainCodeDoes) {
     // w (assigned on another path only) read at each place of each run
     const std::vector<std::string> exprs = {"2*w + 3*y + 4*z + 5*x",

@@ -44,6 +44,48 @@ inline double randLnRecalled(uint64_t seed, double sd, double k1, double k2) {
     thread_local Recall<4, double (*)(double, double, double, double), 1> memo(randLnComputed);
     return memo({sd, std::bit_cast<double>(seed), k1, k2});
 }
+
+// The fused runs' values (fast_instr.h), computed plainly first: +, * and / of a NaN give a
+// NaN, so a value that is not one read no unassigned slot (kUnassignedBits is a NaN) and
+// needed none of the runs' NaN fixes (each gives one NaN for another). Only a NaN is
+// computed again with each instruction's check and fix, in their order: the bits the
+// instructions one by one give, or false where the first of them would stop.
+// MulKL, AddMulKL, AddMulKL, AddMulKL: sum of imm * frame[a] over in[0..4).
+[[gnu::always_inline]] inline bool sumMulKL4(const FastInstr* in, const double* frame, double& v) {
+    const double x0 = frame[in[0].a], x1 = frame[in[1].a];
+    const double x2 = frame[in[2].a], x3 = frame[in[3].a];
+    v = in[0].imm * x0;
+    v = v + in[1].imm * x1;
+    v = v + in[2].imm * x2;
+    v = v + in[3].imm * x3;
+    if (v == v) [[likely]]
+        return true;
+    if (unassignedBits(x0) || unassignedBits(x1)) return false;
+    if (unassignedBits(x2) || unassignedBits(x3)) return false;
+    v = mulFirstNan(in[0].imm, x0);
+    v = addFirstNan(v, mulFirstNan(in[1].imm, x1));
+    v = addFirstNan(v, mulFirstNan(in[2].imm, x2));
+    v = addFirstNan(v, mulFirstNan(in[3].imm, x3));
+    return true;
+}
+// Neg, AddK, MulL after the logarithm l: (-l + k) * x.
+[[gnu::always_inline]] inline bool lnTimes(double l, double k, double x, double& v) {
+    v = (-l + k) * x;
+    if (v == v) [[likely]]
+        return true;
+    if (unassignedBits(x)) return false;
+    v = mulFirstNan(addFirstNan(-l, k), x);
+    return true;
+}
+// AddLL, DivK, AddL: (a + b) / k + c.
+[[gnu::always_inline]] inline bool meanAdd(double a, double b, double k, double c, double& v) {
+    v = (a + b) / k + c;
+    if (v == v) [[likely]]
+        return true;
+    if (unassignedBits(a) || unassignedBits(b) || unassignedBits(c)) return false;
+    v = addFirstNan(addFirstNan(a, b) / k, c);
+    return true;
+}
 }  // namespace
 
 // The machine is threaded: each operation ends by jumping straight to the next one's code
@@ -150,41 +192,30 @@ inline double randLnRecalled(uint64_t seed, double sd, double k1, double k2) {
 // operands, each operation as its own instruction computes it (an unassigned read stops
 // the run; nothing is stored before it, so stopping earlier or later gives the same), then
 // pc skips the run (and does the store after it).
-#define PCSG_FAST_FUSED_RUNS                                              \
-    PCSG_FAST_ADD_MUL_KL                                                  \
-    PCSG_FAST_OP(SumMulKL4) {                                             \
-        const double x0 = frame[in[0].a], x1 = frame[in[1].a];            \
-        const double x2 = frame[in[2].a], x3 = frame[in[3].a];            \
-        if (unassignedBits(x0) || unassignedBits(x1)) return false;       \
-        if (unassignedBits(x2) || unassignedBits(x3)) return false;       \
-        st[sp++] = acc;                                                   \
-        acc = mulFirstNan(in[0].imm, x0);                                 \
-        acc = addFirstNan(acc, mulFirstNan(in[1].imm, x1));               \
-        acc = addFirstNan(acc, mulFirstNan(in[2].imm, x2));               \
-        acc = addFirstNan(acc, mulFirstNan(in[3].imm, x3));               \
-        pc += 3;                                                          \
-        PCSG_FAST_THEN_STORE                                              \
-    }                                                                     \
-    PCSG_FAST_NEXT;                                                       \
-    PCSG_FAST_OP(RandLnChain) {                                           \
-        const double x = frame[in[6].a];                                  \
-        if (unassignedBits(x)) return false;                              \
-        const double l = randLnRecalled(seed, acc, in[1].imm, in[2].imm); \
-        acc = mulFirstNan(addFirstNan(-l, in[5].imm), x);                 \
-        pc += 6;                                                          \
-        PCSG_FAST_THEN_STORE                                              \
-    }                                                                     \
-    PCSG_FAST_NEXT;                                                       \
-    PCSG_FAST_OP(MeanAddL) {                                              \
-        const double a = frame[in[0].a], b = frame[in[0].b];              \
-        const double c = frame[in[2].a];                                  \
-        if (unassignedBits(a) || unassignedBits(b)) return false;         \
-        if (unassignedBits(c)) return false;                              \
-        st[sp++] = acc;                                                   \
-        acc = addFirstNan(addFirstNan(a, b) / in[1].imm, c);              \
-        pc += 2;                                                          \
-        PCSG_FAST_THEN_STORE                                              \
-    }                                                                     \
+#define PCSG_FAST_FUSED_RUNS                                                                      \
+    PCSG_FAST_ADD_MUL_KL                                                                          \
+    PCSG_FAST_OP(SumMulKL4) {                                                                     \
+        double v;                                                                                 \
+        if (!sumMulKL4(in, frame, v)) return false;                                               \
+        st[sp++] = acc, acc = v;                                                                  \
+        pc += 3;                                                                                  \
+        PCSG_FAST_THEN_STORE                                                                      \
+    }                                                                                             \
+    PCSG_FAST_NEXT;                                                                               \
+    PCSG_FAST_OP(RandLnChain) {                                                                   \
+        const double l = randLnRecalled(seed, acc, in[1].imm, in[2].imm);                         \
+        if (!lnTimes(l, in[5].imm, frame[in[6].a], acc)) return false;                            \
+        pc += 6;                                                                                  \
+        PCSG_FAST_THEN_STORE                                                                      \
+    }                                                                                             \
+    PCSG_FAST_NEXT;                                                                               \
+    PCSG_FAST_OP(MeanAddL) {                                                                      \
+        double v;                                                                                 \
+        if (!meanAdd(frame[in[0].a], frame[in[0].b], in[1].imm, frame[in[2].a], v)) return false; \
+        st[sp++] = acc, acc = v;                                                                  \
+        pc += 2;                                                                                  \
+        PCSG_FAST_THEN_STORE                                                                      \
+    }                                                                                             \
     PCSG_FAST_NEXT;
 #define PCSG_FAST_NO_FIX (void)0
 #define PCSG_FAST_PUSH(OP, EXPR) \
