@@ -262,6 +262,36 @@ TEST(FastCode, UnassignedReadsAreReportedAsThePlainCodeReportsThem) {
     EXPECT_EQ(fast, apply(plain));
 }
 
+TEST(FastCode, EachFormStopsAtAnUnassignedParameterWhateverItsOperatorGivesForIt) {
+    // w (unassigned) in each leaf form of each operator: + - * / give a NaN for it and are
+    // tested only when their value is one; the others can give a number (1 ^ w, w ^ 0,
+    // w < x) and are tested always. Each must stop where the plain code reports w.
+    const char* ops[] = {"+", "-", "*", "/", "%", "^", "<", "<=", ">", ">=", "==", "!="};
+    std::vector<std::string> exprs;
+    for (const std::string op : ops)
+        exprs.insert(exprs.end(), {"(x*y) " + op + " w", "1 " + op + " w", "w " + op + " 0",
+                                   "w " + op + " x", "x " + op + " w"});
+    auto c = withExprs(exprs);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Graph plain = plainOf(g);
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    for (Slot s = 0; s < g.slotCount(); ++s)
+        if (g.slotNames[s] != "w") frame[s] = 1;
+    const Calc& calc = g.calcs[calcUnderTest(g)];
+    const std::string dump = dumpFastCalc(g, calcUnderTest(g));
+    for (const char* form : {"PowL w\n", "PowKL 1 w\n", "PowLK w 0\n", "LtLL w x\n", "SubLL x w\n"})
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+    for (uint32_t i = 0; i < calc.count; ++i) {
+        const ExprId e = g.assignments[calc.first + i].value;
+        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
+        EXPECT_NE(fast.find("parameter 'w' is read before it is assigned"), std::string::npos)
+            << exprs[i] << ": " << fast;
+        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
+    }
+}
+
 TEST(FastCode, ChooseWeightErrorsAreReportedAsThePlainCodeReportsThem) {
     auto c = withExprs({"choose(x, y)"});
     ASSERT_TRUE(c->graph);

@@ -116,60 +116,57 @@ inline double randLnRecalled(uint64_t seed, double sd, double k1, double k2) {
             st[sp++] = (KEPT);                    \
         }                                         \
     } while (0)
+// Whether a form stops for its parameter v (checked as PushL), asked after acc has the
+// form's value: where a NaN operand gives a NaN (NAN_OUT: + - * /), only a NaN value can
+// have read kUnassignedBits (itself a NaN), so a number skips the test.
+#define PCSG_FAST_STOPS(NAN_OUT, V) ((!(NAN_OUT) || acc != acc) && unassignedBits(V))
 // One binary operator in its six forms: the left operand popped, then a constant, a
-// parameter, both leaves (constant and parameter, parameter and constant, two parameters). `FIX`
-// runs after the operation: for Add and Mul of two NaNs, x86 gives the first operand's NaN
-// (quietened), and the plain machine's `a + b` takes a as the first; here the compiler may
-// swap the operands of a commutative operator, so the first's NaN is restored explicitly
+// parameter, both leaves (constant and parameter, parameter and constant, two parameters).
+// For Add and Mul of two NaNs, x86 gives the first operand's NaN (quietened), and the plain
+// machine's `a + b` takes a as the first; here the compiler may swap the operands of a
+// commutative operator, so addFirstNan and mulFirstNan restore the first's NaN explicitly
 // (the sign and payload of a NaN reach rand(x) and the error messages).
-#define PCSG_FAST_BINARY(OP, EXPR, FIX)             \
-    PCSG_FAST_OP(OP) {                              \
-        const double a = st[--sp], b = acc;         \
-        acc = (EXPR);                               \
-        FIX;                                        \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##K) {                           \
-        const double a = acc, b = in->imm;          \
-        acc = (EXPR);                               \
-        FIX;                                        \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##L) {                           \
-        const double a = acc, b = frame[in->a];     \
-        if (unassignedBits(b)) return false;        \
-        acc = (EXPR);                               \
-        FIX;                                        \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##KL) {                          \
-        const double a = in->imm, b = frame[in->a]; \
-        if (unassignedBits(b)) return false;        \
-        const double kept = acc;                    \
-        acc = (EXPR);                               \
-        FIX;                                        \
-        PCSG_FAST_SPILL_OR_STORE(kept);             \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##LK) {                          \
-        const double a = frame[in->a], b = in->imm; \
-        if (unassignedBits(a)) return false;        \
-        const double kept = acc;                    \
-        acc = (EXPR);                               \
-        FIX;                                        \
-        PCSG_FAST_SPILL_OR_STORE(kept);             \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##LL) {                          \
-        const double a = frame[in->a];              \
-        const double b = frame[in->b];              \
-        if (unassignedBits(a)) return false;        \
-        if (unassignedBits(b)) return false;        \
-        const double kept = acc;                    \
-        acc = (EXPR);                               \
-        FIX;                                        \
-        PCSG_FAST_SPILL_OR_STORE(kept);             \
-    }                                               \
+#define PCSG_FAST_BINARY(OP, EXPR, NAN_OUT)                                           \
+    PCSG_FAST_OP(OP) {                                                                \
+        const double a = st[--sp], b = acc;                                           \
+        acc = (EXPR);                                                                 \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##K) {                                                             \
+        const double a = acc, b = in->imm;                                            \
+        acc = (EXPR);                                                                 \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##L) {                                                             \
+        const double a = acc, b = frame[in->a];                                       \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, b)) return false;                                \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##KL) {                                                            \
+        const double a = in->imm, b = frame[in->a];                                   \
+        const double kept = acc;                                                      \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, b)) return false;                                \
+        PCSG_FAST_SPILL_OR_STORE(kept);                                               \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##LK) {                                                            \
+        const double a = frame[in->a], b = in->imm;                                   \
+        const double kept = acc;                                                      \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, a)) return false;                                \
+        PCSG_FAST_SPILL_OR_STORE(kept);                                               \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##LL) {                                                            \
+        const double a = frame[in->a];                                                \
+        const double b = frame[in->b];                                                \
+        const double kept = acc;                                                      \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, a) || PCSG_FAST_STOPS(NAN_OUT, b)) return false; \
+        PCSG_FAST_SPILL_OR_STORE(kept);                                               \
+    }                                                                                 \
     PCSG_FAST_NEXT;
 // MulKL and the Add that takes its product: MulKL's value and NaN fix, then Add's.
 #define PCSG_FAST_ADD_MUL_KL                        \
@@ -217,7 +214,6 @@ inline double randLnRecalled(uint64_t seed, double sd, double k1, double k2) {
         PCSG_FAST_THEN_STORE                                                                      \
     }                                                                                             \
     PCSG_FAST_NEXT;
-#define PCSG_FAST_NO_FIX (void)0
 #define PCSG_FAST_PUSH(OP, EXPR) \
     PCSG_FAST_OP(OP)             \
     st[sp++] = acc;              \
@@ -268,18 +264,18 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
     PCSG_FAST_UNARY(Floor, std::floor(acc))
     PCSG_FAST_UNARY(Ceil, std::ceil(acc))
     PCSG_FAST_UNARY(Rand1, randOfInline(seed, acc))
-    PCSG_FAST_BINARY(Add, addFirstNan(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Sub, a - b, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Mul, mulFirstNan(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Div, a / b, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Mod, std::fmod(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Pow, powRecalled(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Lt, a < b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Le, a <= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Gt, a > b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+    PCSG_FAST_BINARY(Add, addFirstNan(a, b), true)
+    PCSG_FAST_BINARY(Sub, a - b, true)
+    PCSG_FAST_BINARY(Mul, mulFirstNan(a, b), true)
+    PCSG_FAST_BINARY(Div, a / b, true)
+    PCSG_FAST_BINARY(Mod, std::fmod(a, b), false)
+    PCSG_FAST_BINARY(Pow, powRecalled(a, b), false)
+    PCSG_FAST_BINARY(Lt, a < b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Le, a <= b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Gt, a > b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0, false)
     PCSG_FAST_FUSED_RUNS
     PCSG_FAST_OP(Call) {
         st[sp] = acc, sp -= in->argc - 1u;
@@ -318,7 +314,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 #undef PCSG_FAST_THEN_STORE
 #undef PCSG_FAST_UNARY
 #undef PCSG_FAST_PUSH
-#undef PCSG_FAST_NO_FIX
+#undef PCSG_FAST_STOPS
 #undef PCSG_FAST_TARGET
 #undef PCSG_FAST_OP
 #undef PCSG_FAST_NEXT
