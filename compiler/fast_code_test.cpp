@@ -228,6 +228,26 @@ std::string errorOf(const Graph& g, F f) {
     return "";
 }
 
+// Each assignment of the C-node under test, expression exprs[i], with every parameter but
+// w (unassigned) at `value`: the fast machine stops where the plain code reports w, in
+// the same words.
+void expectEachReportsW(const Graph& g, const std::vector<std::string>& exprs, double value) {
+    const Graph plain = plainOf(g);
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    for (Slot s = 0; s < g.slotCount(); ++s)
+        if (g.slotNames[s] != "w") frame[s] = value;
+    const Calc& calc = g.calcs[calcUnderTest(g)];
+    ASSERT_EQ(calc.count, exprs.size());
+    for (uint32_t i = 0; i < calc.count; ++i) {
+        const ExprId e = g.assignments[calc.first + i].value;
+        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
+        EXPECT_NE(fast.find("parameter 'w' is read before it is assigned"), std::string::npos)
+            << exprs[i] << ": " << fast;
+        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
+    }
+}
+
 TEST(FastCode, UnassignedReadsAreReportedAsThePlainCodeReportsThem) {
     // w is assigned only on another path: reading it here is the run-time error.
     auto c = withExprs({"x + 1", "y * w", "w", "2 - w", "1 + (x * w)"});
@@ -274,22 +294,10 @@ TEST(FastCode, EachFormStopsAtAnUnassignedParameterWhateverItsOperatorGivesForIt
     auto c = withExprs(exprs);
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
-    const Graph plain = plainOf(g);
-    std::vector<double> frame(g.slotCount());
-    initFrame(g, frame.data());
-    for (Slot s = 0; s < g.slotCount(); ++s)
-        if (g.slotNames[s] != "w") frame[s] = 1;
-    const Calc& calc = g.calcs[calcUnderTest(g)];
     const std::string dump = dumpFastCalc(g, calcUnderTest(g));
     for (const char* form : {"PowL w\n", "PowKL 1 w\n", "PowLK w 0\n", "LtLL w x\n", "SubLL x w\n"})
         EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
-    for (uint32_t i = 0; i < calc.count; ++i) {
-        const ExprId e = g.assignments[calc.first + i].value;
-        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
-        EXPECT_NE(fast.find("parameter 'w' is read before it is assigned"), std::string::npos)
-            << exprs[i] << ": " << fast;
-        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
-    }
+    expectEachReportsW(g, exprs, 1);
 }
 
 TEST(FastCode, ChooseWeightErrorsAreReportedAsThePlainCodeReportsThem) {
@@ -548,19 +556,8 @@ TEST(FastCode, FusedRunsReportUnassignedReadsAsThePlainCodeDoes) {
     auto c = withExprs(exprs);
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
-    const Graph plain = plainOf(g);
-    std::vector<double> frame(g.slotCount());
-    initFrame(g, frame.data());
-    for (Slot s = 0; s < g.slotCount(); ++s)
-        if (g.slotNames[s] != "w") frame[s] = 0.25;
-    const Calc& calc = g.calcs[calcUnderTest(g)];
     EXPECT_NE(dumpFastCalc(g, calcUnderTest(g)).find("SumMulKL4"), std::string::npos);
-    for (uint32_t i = 0; i < calc.count; ++i) {
-        const ExprId e = g.assignments[calc.first + i].value;
-        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
-        EXPECT_NE(fast.find("'w'"), std::string::npos) << exprs[i] << ": " << fast;
-        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
-    }
+    expectEachReportsW(g, exprs, 0.25);
 }
 
 TEST(FastCode, RecalledRandLnChainsAreKeyedByTheirSeedAndConstants) {
