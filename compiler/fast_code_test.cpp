@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 
 #include "compile_test_util.h"
 #include "eval.h"
@@ -226,6 +228,26 @@ std::string errorOf(const Graph& g, F f) {
     return "";
 }
 
+// Each assignment of the C-node under test, expression exprs[i], with every parameter but
+// w (unassigned) at `value`: the fast machine stops where the plain code reports w, in
+// the same words.
+void expectEachReportsW(const Graph& g, const std::vector<std::string>& exprs, double value) {
+    const Graph plain = plainOf(g);
+    std::vector<double> frame(g.slotCount());
+    initFrame(g, frame.data());
+    for (Slot s = 0; s < g.slotCount(); ++s)
+        if (g.slotNames[s] != "w") frame[s] = value;
+    const Calc& calc = g.calcs[calcUnderTest(g)];
+    ASSERT_EQ(calc.count, exprs.size());
+    for (uint32_t i = 0; i < calc.count; ++i) {
+        const ExprId e = g.assignments[calc.first + i].value;
+        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
+        EXPECT_NE(fast.find("parameter 'w' is read before it is assigned"), std::string::npos)
+            << exprs[i] << ": " << fast;
+        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
+    }
+}
+
 TEST(FastCode, UnassignedReadsAreReportedAsThePlainCodeReportsThem) {
     // w is assigned only on another path: reading it here is the run-time error.
     auto c = withExprs({"x + 1", "y * w", "w", "2 - w", "1 + (x * w)"});
@@ -258,6 +280,24 @@ TEST(FastCode, UnassignedReadsAreReportedAsThePlainCodeReportsThem) {
     const std::string fast = apply(g);
     EXPECT_NE(fast.find("'w'"), std::string::npos) << fast;
     EXPECT_EQ(fast, apply(plain));
+}
+
+TEST(FastCode, EachFormStopsAtAnUnassignedParameterWhateverItsOperatorGivesForIt) {
+    // w (unassigned) in each leaf form of each operator: + - * / give a NaN for it and are
+    // tested only when their value is one; the others can give a number (1 ^ w, w ^ 0,
+    // w < x) and are tested always. Each must stop where the plain code reports w.
+    const char* ops[] = {"+", "-", "*", "/", "%", "^", "<", "<=", ">", ">=", "==", "!="};
+    std::vector<std::string> exprs;
+    for (const std::string op : ops)
+        exprs.insert(exprs.end(), {"(x*y) " + op + " w", "1 " + op + " w", "w " + op + " 0",
+                                   "w " + op + " x", "x " + op + " w"});
+    auto c = withExprs(exprs);
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const std::string dump = dumpFastCalc(g, calcUnderTest(g));
+    for (const char* form : {"PowL w\n", "PowKL 1 w\n", "PowLK w 0\n", "LtLL w x\n", "SubLL x w\n"})
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+    expectEachReportsW(g, exprs, 1);
 }
 
 TEST(FastCode, ChooseWeightErrorsAreReportedAsThePlainCodeReportsThem) {
@@ -461,6 +501,48 @@ TEST(FastCode, FusedRunsGiveTheBitsOfTheirInstructionsOneByOne) {
     }
 }
 
+TEST(FastCode, FusedRunsGiveTheBitsOfTheirInstructionsWithNansOfEverySignAndPayload) {
+    // The fused runs compute their value plainly and only a NaN again with each
+    // instruction's fix: operands that are NaNs of other signs and payloads, two or more in
+    // one run, give the bits of the runs' instructions one by one.
+    auto c = withExprs({"2.5*x + 3*y + 0.5*z + 7*x", "((-ln(rand(x)*0.75+1.0))+0.125)*y",
+                        "(x+y)/2.0 + z", "(z+x)/2.0 + y"});
+    ASSERT_TRUE(c->graph);
+    const Graph& g = *c->graph;
+    const Graph unfused = unfusedOf(g);
+    const std::string dump = dumpFastCalc(g, calcUnderTest(g));
+    for (const char* form : {"SumMulKL4", "RandLnChain", "MeanAddL x y", "MeanAddL z x"})
+        EXPECT_NE(dump.find(form), std::string::npos) << form << " missing from\n" << dump;
+    const double nans[] = {std::bit_cast<double>(0x7ff8000000000001ull),
+                           std::bit_cast<double>(0xfff8000000000002ull),
+                           std::bit_cast<double>(0x7ff0000000000003ull),  // signalling
+                           std::bit_cast<double>(0xfff800000000abcdull)};
+    const double values[] = {nans[0], nans[1], nans[2], nans[3], 1.5, -2, kInf, -kInf, 0};
+    const NodeId node = calcNodeUnderTest(g);
+    std::vector<double> frame, fused(g.slotCount()), oneByOne(g.slotCount());
+    int nanValues = 0;
+    for (double x : values)
+        for (double y : values)
+            for (double z : values) {
+                frame.assign(g.slotCount(), 0);
+                initFrame(g, frame.data());
+                for (Slot s = 0; s < g.slotCount(); ++s)
+                    if (g.slotNames[s] == "x" || g.slotNames[s] == "y" || g.slotNames[s] == "z")
+                        frame[s] = g.slotNames[s] == "x" ? x : g.slotNames[s] == "y" ? y : z;
+                const EvalState s{frame.data(), kRootPath};
+                applyCalc(g, node, s, fused.data());
+                applyCalc(unfused, node, s, oneByOne.data());
+                for (Slot i = 0; i < g.slotCount(); ++i) {
+                    ASSERT_EQ(std::bit_cast<uint64_t>(fused[i]),
+                              std::bit_cast<uint64_t>(oneByOne[i]))
+                        << g.slotNames[i] << " with " << describeFrame(g, frame.data()) << "\n"
+                        << dump;
+                    nanValues += std::isnan(fused[i]);
+                }
+            }
+    EXPECT_GT(nanValues, 1000);
+}
+
 TEST(FastCode, FusedRunsReportUnassignedReadsAsThePlainCodeDoes) {
     // w (assigned on another path only) read at each place of each run
     const std::vector<std::string> exprs = {"2*w + 3*y + 4*z + 5*x",
@@ -474,19 +556,44 @@ TEST(FastCode, FusedRunsReportUnassignedReadsAsThePlainCodeDoes) {
     auto c = withExprs(exprs);
     ASSERT_TRUE(c->graph);
     const Graph& g = *c->graph;
-    const Graph plain = plainOf(g);
-    std::vector<double> frame(g.slotCount());
-    initFrame(g, frame.data());
-    for (Slot s = 0; s < g.slotCount(); ++s)
-        if (g.slotNames[s] != "w") frame[s] = 0.25;
-    const Calc& calc = g.calcs[calcUnderTest(g)];
     EXPECT_NE(dumpFastCalc(g, calcUnderTest(g)).find("SumMulKL4"), std::string::npos);
-    for (uint32_t i = 0; i < calc.count; ++i) {
-        const ExprId e = g.assignments[calc.first + i].value;
-        const std::string fast = errorOf(g, [&] { evalExpr(g, e, {frame.data(), kRootPath}); });
-        EXPECT_NE(fast.find("'w'"), std::string::npos) << exprs[i] << ": " << fast;
-        EXPECT_EQ(fast, errorOf(plain, [&] { evalExpr(plain, e, {frame.data(), kRootPath}); }));
+    expectEachReportsW(g, exprs, 0.25);
+}
+
+TEST(FastCode, RecalledRandLnChainsAreKeyedByTheirSeedAndConstants) {
+    // Three rnd chains of the same sd with other constants, in a graph and in its copy with
+    // another seed: each run recalls (a few values of x, many times) only what the same
+    // seed and constants gave, bit for bit the plain code's value.
+    auto c = withExprs({"((-ln(rand(x)*0.75+1.0))+0.125)*z", "((-ln(rand(x)*0.5+1.0))+0.125)*z",
+                        "((-ln(rand(x)*0.75+2.0))+0.125)*z"});
+    ASSERT_TRUE(c->graph);
+    Graph other = *c->graph;
+    other.scene.settings.seed = c->graph->scene.settings.seed + 1;
+    const Graph* graphs[] = {&*c->graph, &other};
+    const Graph plains[] = {plainOf(*c->graph), plainOf(other)};
+    const NodeId node = calcNodeUnderTest(other);
+    const auto slotOf = [&](const char* name) {
+        return static_cast<Slot>(std::find(other.slotNames.begin(), other.slotNames.end(), name) -
+                                 other.slotNames.begin());
+    };
+    const Slot x = slotOf("x"), z = slotOf("z");
+    std::vector<double> frame, fast(other.slotCount()), slow(other.slotCount());
+    std::set<uint64_t> values;
+    for (int k = 0; k < 600; ++k) {
+        const Graph& g = *graphs[k % 2];
+        frame.assign(g.slotCount(), 0);
+        initFrame(g, frame.data());
+        frame[x] = 0.5 * (k / 2 % 5) - 1, frame[z] = 1.5;
+        const EvalState s{frame.data(), kRootPath};
+        applyCalc(g, node, s, fast.data());
+        applyCalc(plains[k % 2], node, s, slow.data());
+        for (Slot i = 0; i < g.slotCount(); ++i)
+            ASSERT_EQ(std::bit_cast<uint64_t>(fast[i]), std::bit_cast<uint64_t>(slow[i]))
+                << g.slotNames[i] << " of graph " << k % 2 << " with x = " << frame[x];
+        for (const char* r : {"r1", "r2", "r3"})
+            values.insert(std::bit_cast<uint64_t>(fast[slotOf(r)]));
     }
+    EXPECT_EQ(values.size(), 2u * 5u * 3u);  // each seed, x and chain its own value
 }
 
 TEST(FastCode, TwoLeavesAndTheirOperatorStoreWithoutTheStoresDispatch) {

@@ -7,6 +7,7 @@
 
 #include "eval.h"
 #include "eval_core.h"
+#include "eval_recall.h"
 
 namespace pcsg {
 
@@ -26,6 +27,64 @@ inline double addFirstNan(double a, double b) {
 inline double mulFirstNan(double a, double b) {
     const double r = a * b;
     return r != r && a != a ? a * a : r;
+}
+
+// The rnd chain's first four operations, ln(rand(sd)*k1 + k2), as Rand1, MulK, AddK and Ln
+// compute them (Ln's lnRecalled gives std::log's bits; its table is not consulted here,
+// where the chain's own table below missed).
+double randLnComputed(double sd, double seedBits, double k1, double k2) {
+    const double u = randOfInline(std::bit_cast<uint64_t>(seedBits), sd);
+    return std::log(addFirstNan(mulFirstNan(u, k1), k2));
+}
+
+// The same, recalled by the bits of sd, the seed, k1 and k2 (slots chosen by sd's alone):
+// the two triangles at an edge, and every expansion of them, seed the same rnd. A hit skips
+// rand()'s three mixes and the logarithm's own recall.
+inline double randLnRecalled(uint64_t seed, double sd, double k1, double k2) {
+    thread_local Recall<4, double (*)(double, double, double, double), 1> memo(randLnComputed);
+    return memo({sd, std::bit_cast<double>(seed), k1, k2});
+}
+
+// The fused runs' values (fast_instr.h), computed plainly first: +, * and / of a NaN give a
+// NaN, so a value that is not one read no unassigned slot (kUnassignedBits is a NaN) and
+// needed none of the runs' NaN fixes (each gives one NaN for another). Only a NaN is
+// computed again with each instruction's check and fix, in their order: the bits the
+// instructions one by one give, or false where the first of them would stop.
+// MulKL, AddMulKL, AddMulKL, AddMulKL: sum of imm * frame[a] over in[0..4).
+[[gnu::always_inline]] inline bool sumMulKL4(const FastInstr* in, const double* frame, double& v) {
+    const double x0 = frame[in[0].a], x1 = frame[in[1].a];
+    const double x2 = frame[in[2].a], x3 = frame[in[3].a];
+    v = in[0].imm * x0;
+    v = v + in[1].imm * x1;
+    v = v + in[2].imm * x2;
+    v = v + in[3].imm * x3;
+    if (v == v) [[likely]]
+        return true;
+    if (unassignedBits(x0) || unassignedBits(x1)) return false;
+    if (unassignedBits(x2) || unassignedBits(x3)) return false;
+    v = mulFirstNan(in[0].imm, x0);
+    v = addFirstNan(v, mulFirstNan(in[1].imm, x1));
+    v = addFirstNan(v, mulFirstNan(in[2].imm, x2));
+    v = addFirstNan(v, mulFirstNan(in[3].imm, x3));
+    return true;
+}
+// Neg, AddK, MulL after the logarithm l: (-l + k) * x.
+[[gnu::always_inline]] inline bool lnTimes(double l, double k, double x, double& v) {
+    v = (-l + k) * x;
+    if (v == v) [[likely]]
+        return true;
+    if (unassignedBits(x)) return false;
+    v = mulFirstNan(addFirstNan(-l, k), x);
+    return true;
+}
+// AddLL, DivK, AddL: (a + b) / k + c.
+[[gnu::always_inline]] inline bool meanAdd(double a, double b, double k, double c, double& v) {
+    v = (a + b) / k + c;
+    if (v == v) [[likely]]
+        return true;
+    if (unassignedBits(a) || unassignedBits(b) || unassignedBits(c)) return false;
+    v = addFirstNan(addFirstNan(a, b) / k, c);
+    return true;
 }
 }  // namespace
 
@@ -57,60 +116,57 @@ inline double mulFirstNan(double a, double b) {
             st[sp++] = (KEPT);                    \
         }                                         \
     } while (0)
+// Whether a form stops for its parameter v (checked as PushL), asked after acc has the
+// form's value: where a NaN operand gives a NaN (NAN_OUT: + - * /), only a NaN value can
+// have read kUnassignedBits (itself a NaN), so a number skips the test.
+#define PCSG_FAST_STOPS(NAN_OUT, V) ((!(NAN_OUT) || acc != acc) && unassignedBits(V))
 // One binary operator in its six forms: the left operand popped, then a constant, a
-// parameter, both leaves (constant and parameter, parameter and constant, two parameters). `FIX`
-// runs after the operation: for Add and Mul of two NaNs, x86 gives the first operand's NaN
-// (quietened), and the plain machine's `a + b` takes a as the first; here the compiler may
-// swap the operands of a commutative operator, so the first's NaN is restored explicitly
+// parameter, both leaves (constant and parameter, parameter and constant, two parameters).
+// For Add and Mul of two NaNs, x86 gives the first operand's NaN (quietened), and the plain
+// machine's `a + b` takes a as the first; here the compiler may swap the operands of a
+// commutative operator, so addFirstNan and mulFirstNan restore the first's NaN explicitly
 // (the sign and payload of a NaN reach rand(x) and the error messages).
-#define PCSG_FAST_BINARY(OP, EXPR, FIX)             \
-    PCSG_FAST_OP(OP) {                              \
-        const double a = st[--sp], b = acc;         \
-        acc = (EXPR);                               \
-        FIX;                                        \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##K) {                           \
-        const double a = acc, b = in->imm;          \
-        acc = (EXPR);                               \
-        FIX;                                        \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##L) {                           \
-        const double a = acc, b = frame[in->a];     \
-        if (unassignedBits(b)) return false;        \
-        acc = (EXPR);                               \
-        FIX;                                        \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##KL) {                          \
-        const double a = in->imm, b = frame[in->a]; \
-        if (unassignedBits(b)) return false;        \
-        const double kept = acc;                    \
-        acc = (EXPR);                               \
-        FIX;                                        \
-        PCSG_FAST_SPILL_OR_STORE(kept);             \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##LK) {                          \
-        const double a = frame[in->a], b = in->imm; \
-        if (unassignedBits(a)) return false;        \
-        const double kept = acc;                    \
-        acc = (EXPR);                               \
-        FIX;                                        \
-        PCSG_FAST_SPILL_OR_STORE(kept);             \
-    }                                               \
-    PCSG_FAST_NEXT;                                 \
-    PCSG_FAST_OP(OP##LL) {                          \
-        const double a = frame[in->a];              \
-        const double b = frame[in->b];              \
-        if (unassignedBits(a)) return false;        \
-        if (unassignedBits(b)) return false;        \
-        const double kept = acc;                    \
-        acc = (EXPR);                               \
-        FIX;                                        \
-        PCSG_FAST_SPILL_OR_STORE(kept);             \
-    }                                               \
+#define PCSG_FAST_BINARY(OP, EXPR, NAN_OUT)                                           \
+    PCSG_FAST_OP(OP) {                                                                \
+        const double a = st[--sp], b = acc;                                           \
+        acc = (EXPR);                                                                 \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##K) {                                                             \
+        const double a = acc, b = in->imm;                                            \
+        acc = (EXPR);                                                                 \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##L) {                                                             \
+        const double a = acc, b = frame[in->a];                                       \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, b)) return false;                                \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##KL) {                                                            \
+        const double a = in->imm, b = frame[in->a];                                   \
+        const double kept = acc;                                                      \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, b)) return false;                                \
+        PCSG_FAST_SPILL_OR_STORE(kept);                                               \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##LK) {                                                            \
+        const double a = frame[in->a], b = in->imm;                                   \
+        const double kept = acc;                                                      \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, a)) return false;                                \
+        PCSG_FAST_SPILL_OR_STORE(kept);                                               \
+    }                                                                                 \
+    PCSG_FAST_NEXT;                                                                   \
+    PCSG_FAST_OP(OP##LL) {                                                            \
+        const double a = frame[in->a];                                                \
+        const double b = frame[in->b];                                                \
+        const double kept = acc;                                                      \
+        acc = (EXPR);                                                                 \
+        if (PCSG_FAST_STOPS(NAN_OUT, a) || PCSG_FAST_STOPS(NAN_OUT, b)) return false; \
+        PCSG_FAST_SPILL_OR_STORE(kept);                                               \
+    }                                                                                 \
     PCSG_FAST_NEXT;
 // MulKL and the Add that takes its product: MulKL's value and NaN fix, then Add's.
 #define PCSG_FAST_ADD_MUL_KL                        \
@@ -133,44 +189,31 @@ inline double mulFirstNan(double a, double b) {
 // operands, each operation as its own instruction computes it (an unassigned read stops
 // the run; nothing is stored before it, so stopping earlier or later gives the same), then
 // pc skips the run (and does the store after it).
-#define PCSG_FAST_FUSED_RUNS                                                            \
-    PCSG_FAST_ADD_MUL_KL                                                                \
-    PCSG_FAST_OP(SumMulKL4) {                                                           \
-        const double x0 = frame[in[0].a], x1 = frame[in[1].a];                          \
-        const double x2 = frame[in[2].a], x3 = frame[in[3].a];                          \
-        if (unassignedBits(x0) || unassignedBits(x1)) return false;                     \
-        if (unassignedBits(x2) || unassignedBits(x3)) return false;                     \
-        st[sp++] = acc;                                                                 \
-        acc = mulFirstNan(in[0].imm, x0);                                               \
-        acc = addFirstNan(acc, mulFirstNan(in[1].imm, x1));                             \
-        acc = addFirstNan(acc, mulFirstNan(in[2].imm, x2));                             \
-        acc = addFirstNan(acc, mulFirstNan(in[3].imm, x3));                             \
-        pc += 3;                                                                        \
-        PCSG_FAST_THEN_STORE                                                            \
-    }                                                                                   \
-    PCSG_FAST_NEXT;                                                                     \
-    PCSG_FAST_OP(RandLnChain) {                                                         \
-        const double x = frame[in[6].a];                                                \
-        if (unassignedBits(x)) return false;                                            \
-        const double u = randOfInline(seed, acc);                                       \
-        const double l = lnRecalled(addFirstNan(mulFirstNan(u, in[1].imm), in[2].imm)); \
-        acc = mulFirstNan(addFirstNan(-l, in[5].imm), x);                               \
-        pc += 6;                                                                        \
-        PCSG_FAST_THEN_STORE                                                            \
-    }                                                                                   \
-    PCSG_FAST_NEXT;                                                                     \
-    PCSG_FAST_OP(MeanAddL) {                                                            \
-        const double a = frame[in[0].a], b = frame[in[0].b];                            \
-        const double c = frame[in[2].a];                                                \
-        if (unassignedBits(a) || unassignedBits(b)) return false;                       \
-        if (unassignedBits(c)) return false;                                            \
-        st[sp++] = acc;                                                                 \
-        acc = addFirstNan(addFirstNan(a, b) / in[1].imm, c);                            \
-        pc += 2;                                                                        \
-        PCSG_FAST_THEN_STORE                                                            \
-    }                                                                                   \
+#define PCSG_FAST_FUSED_RUNS                                                                      \
+    PCSG_FAST_ADD_MUL_KL                                                                          \
+    PCSG_FAST_OP(SumMulKL4) {                                                                     \
+        double v;                                                                                 \
+        if (!sumMulKL4(in, frame, v)) return false;                                               \
+        st[sp++] = acc, acc = v;                                                                  \
+        pc += 3;                                                                                  \
+        PCSG_FAST_THEN_STORE                                                                      \
+    }                                                                                             \
+    PCSG_FAST_NEXT;                                                                               \
+    PCSG_FAST_OP(RandLnChain) {                                                                   \
+        const double l = randLnRecalled(seed, acc, in[1].imm, in[2].imm);                         \
+        if (!lnTimes(l, in[5].imm, frame[in[6].a], acc)) return false;                            \
+        pc += 6;                                                                                  \
+        PCSG_FAST_THEN_STORE                                                                      \
+    }                                                                                             \
+    PCSG_FAST_NEXT;                                                                               \
+    PCSG_FAST_OP(MeanAddL) {                                                                      \
+        double v;                                                                                 \
+        if (!meanAdd(frame[in[0].a], frame[in[0].b], in[1].imm, frame[in[2].a], v)) return false; \
+        st[sp++] = acc, acc = v;                                                                  \
+        pc += 2;                                                                                  \
+        PCSG_FAST_THEN_STORE                                                                      \
+    }                                                                                             \
     PCSG_FAST_NEXT;
-#define PCSG_FAST_NO_FIX (void)0
 #define PCSG_FAST_PUSH(OP, EXPR) \
     PCSG_FAST_OP(OP)             \
     st[sp++] = acc;              \
@@ -221,18 +264,18 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
     PCSG_FAST_UNARY(Floor, std::floor(acc))
     PCSG_FAST_UNARY(Ceil, std::ceil(acc))
     PCSG_FAST_UNARY(Rand1, randOfInline(seed, acc))
-    PCSG_FAST_BINARY(Add, addFirstNan(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Sub, a - b, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Mul, mulFirstNan(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Div, a / b, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Mod, std::fmod(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Pow, powRecalled(a, b), PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Lt, a < b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Le, a <= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Gt, a > b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
-    PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0, PCSG_FAST_NO_FIX)
+    PCSG_FAST_BINARY(Add, addFirstNan(a, b), true)
+    PCSG_FAST_BINARY(Sub, a - b, true)
+    PCSG_FAST_BINARY(Mul, mulFirstNan(a, b), true)
+    PCSG_FAST_BINARY(Div, a / b, true)
+    PCSG_FAST_BINARY(Mod, std::fmod(a, b), false)
+    PCSG_FAST_BINARY(Pow, powRecalled(a, b), false)
+    PCSG_FAST_BINARY(Lt, a < b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Le, a <= b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Gt, a > b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Ge, a >= b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Eq, a == b ? 1.0 : 0.0, false)
+    PCSG_FAST_BINARY(Ne, a != b ? 1.0 : 0.0, false)
     PCSG_FAST_FUSED_RUNS
     PCSG_FAST_OP(Call) {
         st[sp] = acc, sp -= in->argc - 1u;
@@ -271,7 +314,7 @@ bool runFast(const Graph& g, uint32_t start, const double* frame, double* out, u
 #undef PCSG_FAST_THEN_STORE
 #undef PCSG_FAST_UNARY
 #undef PCSG_FAST_PUSH
-#undef PCSG_FAST_NO_FIX
+#undef PCSG_FAST_STOPS
 #undef PCSG_FAST_TARGET
 #undef PCSG_FAST_OP
 #undef PCSG_FAST_NEXT
