@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <random>
 #include <thread>
 
@@ -76,10 +77,16 @@ TEST(UnrollCache, ThreadsAskingForOneInstanceGetOneObjectBuiltOnce) {
         threads.emplace_back([&, t] {
             Flower f(*c->graph);
             UnrollCache::Reader reader(cache);
-            // nullptr while it is a note or in construction elsewhere
-            for (int i = 0; i < 100000 && !got[t]; ++i) {
-                const UnrollCache::Pin pin(&reader);
-                got[t] = f.get(reader, 21);
+            // nullptr while it is a note or in construction elsewhere: asked again until
+            // it is built (a loaded machine, or a sanitizer's, may keep the builder from
+            // running for a long while: no count of tries, only a guard against a hang)
+            const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+            while (!got[t] && std::chrono::steady_clock::now() < give_up) {
+                {
+                    const UnrollCache::Pin pin(&reader);
+                    got[t] = f.get(reader, 21);
+                }
+                if (!got[t]) std::this_thread::yield();
             }
         });
     for (auto& t : threads) t.join();
