@@ -77,6 +77,7 @@ struct Worker {
     AaEncodeMemo encode;
     Region tile{0, 0, 0, 0}, area{0, 0, 0, 0};
     uint64_t pass = 0;
+    std::vector<float> row;  // a row being handed over, its supersampled colours in
 };
 
 // Each adaptive pass of a TileRender, numbered (workers outlive a render).
@@ -111,10 +112,12 @@ class TileRender {
           sink_(sink),
           windowRows_(std::min(halo_.height(), kWindowRows)) {
         rgb_.assign(static_cast<size_t>(windowRows_) * halo_.width() * 3, 0.0f);
+        sampled_ = std::make_unique<std::atomic<int>[]>(tilesAcross(halo_));
         if (opt.adaptive <= 0) return;
         const size_t width = region_.width();
-        differs_.assign(static_cast<size_t>(std::min(region_.height(), 2 * kTile)) * width, 0);
-        band2_.assign(static_cast<size_t>(std::min(region_.height(), kTile)) * width * 3, 0.0f);
+        const size_t rows = std::min(region_.height(), kDecidedRows);
+        differs_.assign(rows * width, 0);
+        super_.assign(rows * width * 3, 0.0f);
     }
 
     // Runs both passes on the calling thread's pool, handing the region's rows to the sink;
@@ -133,12 +136,19 @@ class TileRender {
   private:
     // The decision between the passes, and the hand-over of finished rows to the sink: not
     // passes of their own for tileTime and progress.
-    static constexpr int kDecide = 0, kEmit = 3;
-    // The rows of the image kept at once (the window): those of the band in pass 1, of the
-    // two before it (being decided and supersampled), of the one before them (being handed
-    // over) and the border rows above and below. (65 are in use at most: the last band's
-    // border row below is written in the step that hands over the band 65 rows above it.)
-    static constexpr int kWindowRows = 4 * kTile + 2;
+    static constexpr int kEmit = 3;  // (passes 1 and 2 are the samples)
+    // The rows of the image kept at once (the window): those of the band in pass 1 with
+    // the border rows above and below it, and the rows decided in the step before, which
+    // are being handed over. (34 are in use at most: the last band's border row below is
+    // written in the step that hands over the row 33 above it.)
+    static constexpr int kWindowRows = 2 * kTile + 2;
+    // The rows of differs_ and super_: those decided in two steps (the last has a row more).
+    static constexpr int kDecidedRows = 2 * kTile + 2;
+
+    struct Job {
+        int pass;
+        Region tile;
+    };
 
     static int tileCount(const Region& r) {
         return ((r.width() + kTile - 1) / kTile) * ((r.height() + kTile - 1) / kTile);
@@ -147,46 +157,88 @@ class TileRender {
     static int tilesAcross(const Region& r) { return (r.width() + kTile - 1) / kTile; }
     int bandCount() const { return (region_.height() + kTile - 1) / kTile; }
 
-    // The region in bands of kTile rows, each band's rows handed to the sink a step or three
-    // after its pass 1, so that the image is kept as a window of kWindowRows rows (0.5 MB
-    // at 640 wide, where the whole image's floats were 3.7 MB). Without adaptive sampling
-    // step k runs pass 1 of band k beside the hand-over of band k-1.
+    // The region in bands of kTile rows, each band's rows handed to the sink in the step
+    // after its pass 1, so that the image is kept as a window of kWindowRows rows (0.26 MB
+    // at 640 wide, where the whole image's floats were 3.7 MB). Step k runs, on the pool,
+    // pass 1 of band k (with the image's border row above band 0 and below the last) beside
+    // the hand-over of the rows finished in step k-1.
     //
-    // Adaptive sampling (POV-Ray's +A, method 1) goes band by band too, so that a band's
-    // pass 2 follows its pass 1 closely and finds the expansions its rays made still in the
-    // cache (a terrain's patches: two whole-image passes had rebuilt nearly every patch for
-    // pass 2). Step k runs, on the pool, pass 1 of band k (with the image's border row
-    // above band 0 and below the last) beside pass 2 of band k-2 and the hand-over of band
-    // k-3; then decides band k-1, whose neighbours' centres are all in by then; then
-    // writes band k-2's supersampled pixels, which the decision of band k-1 was the last
-    // to read as centres. Each pixel depends only on its own samples and its neighbours'
+    // Adaptive sampling (POV-Ray's +A, method 1) decides and supersamples, in step k, the
+    // rows whose neighbours' centres are then all in: band k shifted up a row
+    // (decidedRows(k)), a tile as soon as pass 1 has passed the tiles beside it, so that
+    // its rays find the expansions pass 1's rays made a moment before still in the cache
+    // (a terrain's patches: two whole-image passes had rebuilt nearly every patch, and
+    // pass 2 two bands behind pass 1 still 60% of them). The supersampled colours go to
+    // super_, not over the centres the next rows' decisions read; the hand-over takes
+    // them from there. Each pixel depends only on its own samples and its neighbours'
     // centres, so the image is the one two whole passes give.
     void renderInBands() {
         const int bands = bandCount();
         const bool adaptive = opt_.adaptive > 0;
-        const int lag = adaptive ? 3 : 1;  // from a band's pass 1 to its hand-over
-        const uint64_t pass = ++adaptivePasses;
-        for (int k = 0; k < bands + lag && !stop_; ++k) {
+        for (int k = 0; k <= bands && !stop_; ++k) {
             std::vector<Job> jobs;
-            if (k < bands) addTiles(jobs, 1, bandRows(k, true));
-            if (adaptive && k >= 2 && k - 2 < bands) addTiles(jobs, 2, bandRows(k - 2, false));
-            if (k >= lag) addRows(jobs, bandRows(k - lag, false));
+            if (k < bands) addBandJobs(jobs, k, adaptive);
+            if (k >= 1) addRows(jobs, adaptive ? decidedRows(k - 1) : bandRows(k - 1, false));
+            const uint64_t pass = ++adaptivePasses;  // (a worker's encoded tile: this step's)
             runJobs(jobs, [&](Worker& wk, int jobPass, int y, int x0, int x1) {
                 if (jobPass == 1) return sampleRow(wk, y, x0, x1);
-                if (jobPass == kEmit) return sink_(y, {pixelAt(x0, y), size_t(x1 - x0) * 3});
-                const int y0 = bandRows(k - 2, false).y0;
-                for (int x = x0; x < x1; ++x)
-                    if (differs_[differsIndex(x, y)])
-                        supersamplePixel(wk, x, y, bandPixel(band2_, x, y - y0));
+                if (jobPass == 2) return superRow(wk, pass, y, x0, x1);
+                emitRow(wk, y, x0, x1, adaptive);
             });
-            if (!adaptive) continue;
-            if (k >= 1 && k - 1 < bands && !stop_)
-                forTiles(kDecide, bandRows(k - 1, false), [&](Worker& wk, int y, int x0, int x1) {
-                    for (int x = x0; x < x1; ++x)
-                        differs_[differsIndex(x, y)] = differsFromNeighbour(wk, pass, x, y);
-                });
-            if (k >= 2 && k - 2 < bands && !stop_) storeBand(bandRows(k - 2, false));
         }
+    }
+
+    // Band k's pass-1 tiles, column by column, and with adaptive sampling the tiles of
+    // decidedRows(k) (pass 2), each after the column that follows the last it waits for.
+    void addBandJobs(std::vector<Job>& jobs, int k, bool adaptive) {
+        const Region area = bandRows(k, true);
+        const int columns = tilesAcross(area);
+        sampleRowsOfTiles_ = (area.height() + kTile - 1) / kTile;
+        for (int c = 0; c < columns; ++c) sampled_[c].store(0, std::memory_order_relaxed);
+        const Region rows = decidedRows(k);
+        int next = 0;  // the next tile of `rows` to add
+        for (int c = 0; c <= columns; ++c) {
+            for (int y0 = area.y0; c < columns && y0 < area.y1; y0 += kTile) {
+                const int x0 = area.x0 + c * kTile;
+                jobs.push_back({1, Region{x0, y0, std::min(area.x1, x0 + kTile),
+                                          std::min(area.y1, y0 + kTile)}});
+            }
+            for (; adaptive && next < tilesAcross(rows); ++next) {
+                const Region t = superTile(rows, next);
+                if (c < columns && sampledColumns(t).second >= c) break;
+                jobs.push_back({2, t});
+            }
+        }
+    }
+
+    // Tile i of the decided rows (all of them: a row or two more than kTile at most).
+    static Region superTile(const Region& rows, int i) {
+        const int x0 = rows.x0 + i * kTile;
+        return Region{x0, rows.y0, std::min(rows.x1, x0 + kTile), rows.y1};
+    }
+
+    // The first and last column of pass-1 tiles whose centres the decisions of tile t read.
+    std::pair<int, int> sampledColumns(const Region& t) const {
+        const int last = tilesAcross(halo_) - 1;
+        return {std::max(0, (t.x0 - 1 - halo_.x0) / kTile),
+                std::min(last, (std::min(t.x1, halo_.x1 - 1) - halo_.x0) / kTile)};
+    }
+
+    // Waits until pass 1 has finished the columns of tiles that pass-2 tile t reads (they
+    // were handed out before it: a thread that waits here never waits for itself).
+    void awaitSampled(const Region& t) {
+        const auto [c0, c1] = sampledColumns(t);
+        for (int c = c0; c <= c1; ++c)
+            while (sampled_[c].load(std::memory_order_acquire) < sampleRowsOfTiles_ && !stop_)
+                std::this_thread::yield();
+    }
+
+    // The rows decided in step k: band k shifted up a row (their neighbours below are then
+    // in band k), from the region's first row and to its last.
+    Region decidedRows(int k) const {
+        const Region band = bandRows(k, false);
+        return Region{band.x0, std::max(region_.y0, band.y0 - 1), band.x1,
+                      band.y1 == region_.y1 ? band.y1 : band.y1 - 1};
     }
 
     // Band b's rows of the region (with the image's border rows of pass 1 when `halo`).
@@ -200,28 +252,27 @@ class TileRender {
         return r;
     }
 
-    float* bandPixel(std::vector<float>& band, int x, int row) const {
-        return band.data() + (static_cast<size_t>(row) * region_.width() + (x - region_.x0)) * 3;
+    // Pass 2 over pixels [x0, x1) of decided row y: each pixel's decision, and where it
+    // differs, its supersampled colour into super_.
+    void superRow(Worker& wk, uint64_t pass, int y, int x0, int x1) {
+        for (int x = x0; x < x1; ++x) {
+            const bool differs = differsFromNeighbour(wk, pass, x, y);
+            differs_[decidedIndex(x, y)] = differs;
+            if (differs) supersamplePixel(wk, x, y, super_.data() + decidedIndex(x, y) * 3);
+        }
     }
 
-    // Pass 2's pixels of a band into the image.
-    void storeBand(const Region& band) {
-        for (int y = band.y0; y < band.y1; ++y)
-            for (int x = band.x0; x < band.x1; ++x)
-                if (differs_[differsIndex(x, y)])
-                    std::copy_n(bandPixel(band2_, x, y - band.y0), 3, pixelAt(x, y));
-    }
-
-    struct Job {
-        int pass;
-        Region tile;
-    };
-
-    static void addTiles(std::vector<Job>& jobs, int pass, const Region& area) {
-        for (int y0 = area.y0; y0 < area.y1; y0 += kTile)
-            for (int x0 = area.x0; x0 < area.x1; x0 += kTile)
-                jobs.push_back({pass, Region{x0, y0, std::min(area.x1, x0 + kTile),
-                                             std::min(area.y1, y0 + kTile)}});
+    // Hands over pixels [x0, x1) of row y: the centres, or with adaptive sampling the
+    // supersampled colours where they differ (in the worker's row).
+    void emitRow(Worker& wk, int y, int x0, int x1, bool adaptive) {
+        const float* p = pixelAt(x0, y);
+        const size_t n = static_cast<size_t>(x1 - x0) * 3;
+        if (!adaptive) return sink_(y, {p, n});
+        wk.row.assign(p, p + n);
+        for (int x = x0; x < x1; ++x)
+            if (differs_[decidedIndex(x, y)])
+                std::copy_n(super_.data() + decidedIndex(x, y) * 3, 3, &wk.row[(x - x0) * 3]);
+        sink_(y, {wk.row.data(), n});
     }
 
     // The hand-over of each of the area's rows, a job each.
@@ -235,21 +286,12 @@ class TileRender {
     void runJobs(const std::vector<Job>& jobs, Row&& row) {
         parallelFor(jobs.size(), [&](size_t j, int slot) {
             const int pass = jobs[j].pass;
+            const Region& t = jobs[j].tile;
             auto rowOfPass = [&](Worker& wk, int y, int x0, int x1) { row(wk, pass, y, x0, x1); };
-            runTile(slot, pass, jobs[j].tile, rowOfPass);
-        });
-    }
-
-    // Runs row(worker, y, x0, x1) over the pixels [x0, x1) of each row of the area, in tiles
-    // of kTile x kTile in parallel.
-    template <class Row>
-    void forTiles(int pass, const Region& area, Row&& row) {
-        const size_t tilesX = (area.width() + kTile - 1) / kTile;
-        parallelFor(tileCount(area), [&](size_t tile, int slot) {
-            const int x0 = area.x0 + static_cast<int>(tile % tilesX) * kTile;
-            const int y0 = area.y0 + static_cast<int>(tile / tilesX) * kTile;
-            const Region t{x0, y0, std::min(area.x1, x0 + kTile), std::min(area.y1, y0 + kTile)};
-            runTile(slot, pass, t, row);
+            if (pass == 2) awaitSampled(t);
+            runTile(slot, pass, t, rowOfPass);
+            if (pass == 1)
+                sampled_[(t.x0 - halo_.x0) / kTile].fetch_add(1, std::memory_order_release);
         });
     }
 
@@ -272,16 +314,17 @@ class TileRender {
             stop_ = true;
             return false;
         }
-        if (pass == kDecide || pass == kEmit) return true;
+        if (pass == kEmit) return true;
         if (opt_.tileTime) opt_.tileTime(pass, t.x0, t.y0, t.x1, t.y1, threadCpuSeconds() - start);
         const int d = ++done_;
         if (opt_.progress) opt_.progress(static_cast<double>(d) / totalWork_);
         return true;
     }
 
-    // Pixel (x, y)'s byte of `differs_`, which holds two bands.
-    size_t differsIndex(int x, int y) const {
-        return static_cast<size_t>((y - region_.y0) % (2 * kTile)) * region_.width() +
+    // Pixel (x, y)'s index in differs_ (and its colour's in super_), which hold the rows
+    // decided in two steps.
+    size_t decidedIndex(int x, int y) const {
+        return static_cast<size_t>((y - region_.y0) % kDecidedRows) * region_.width() +
                (x - region_.x0);
     }
 
@@ -420,8 +463,11 @@ class TileRender {
     const RowSink& sink_;
     const int windowRows_;
     std::vector<float> rgb_;        // the window: windowRows_ rows of halo_'s pixels
-    std::vector<uint8_t> differs_;  // adaptive sampling: the decision of two bands' pixels
-    std::vector<float> band2_;      // pass 2's pixels of the band in flight, by region row
+    std::vector<uint8_t> differs_;  // adaptive sampling: the decisions (decidedIndex)
+    std::vector<float> super_;      // and the supersampled colours where they differ
+    // Step k's pass-1 tiles finished, by column, and how many rows of tiles a column has.
+    std::unique_ptr<std::atomic<int>[]> sampled_;
+    int sampleRowsOfTiles_ = 0;
     std::mutex errorMutex_;
     std::exception_ptr firstError_;
     std::atomic<bool> stop_{false};

@@ -215,12 +215,12 @@ TEST(Render, ARegionHasTheWholeImagesPixels) {
     }
 }
 
-// The render keeps a window of 66 rows and hands each finished row to a sink: every row
+// The render keeps a window of 34 rows and hands each finished row to a sink: every row
 // comes once, and is the row that regions of at most 32 rows (whose window holds them
 // whole) give, for sizes below a tile, widths that are not a multiple of it, heights of
 // several windows, with and without adaptive sampling, on 1 to 3 threads; and so is a
 // region with border rows above and below (the bottom one is written in the step that
-// hands over the rows 65 above it: the test fails with a window of 64 rows).
+// hands over the row 33 above it: the test fails with a window of 33 rows).
 TEST(Render, TheWindowsRowsAreTheWholeImages) {
     auto c = compile(kBusyScene);
     ASSERT_TRUE(c->graph);
@@ -268,6 +268,48 @@ TEST(Render, TheWindowsRowsAreTheWholeImages) {
                               0)
                         << "row " << y << " of the inner region";
             }
+}
+
+// Adaptive sampling supersamples a tile as soon as pass 1 has passed the tiles beside it
+// (its rays then find the expansions pass 1's rays made still in the cache): on one
+// thread, at most two pass-1 tiles come between a pass-2 tile and the pass-1 tile of its
+// own column and band, and none of the pass-1 tiles whose centres it reads comes after
+// it. (Pass 2 of a band beside pass 1 of the band two below had 20 and more between them.)
+TEST(Render, SupersamplingFollowsPassOneTwoTilesBehind) {
+    auto c = compile(kBusyScene);
+    ASSERT_TRUE(c->graph);
+    struct Tile {
+        int pass, x0, y0, x1, y1;
+    };
+    std::vector<Tile> order;
+    RenderOptions o = small(1);
+    o.width = 150, o.height = 70, o.adaptive = 0.1;
+    o.tileTime = [&](int pass, int x0, int y0, int x1, int y1, double) {
+        order.push_back({pass, x0, y0, x1, y1});
+    };
+    render(*c->graph, o);
+    size_t superTiles = 0;
+    for (size_t i = 0; i < order.size(); ++i) {
+        const Tile& t = order[i];
+        if (t.pass != 2) continue;
+        ++superTiles;
+        SCOPED_TRACE(::testing::Message() << "pass-2 tile at " << t.x0 << "," << t.y0);
+        // (the pass-1 band of its last row but one: its rows are a band's shifted up a row)
+        const int band = (t.y1 - 2) / 16 * 16;
+        int own = -1;
+        for (size_t k = 0; k < i; ++k)
+            if (order[k].pass == 1 && order[k].x0 == t.x0 && order[k].y0 == band) own = int(k);
+        ASSERT_GE(own, 0);
+        int between = 0;
+        for (size_t k = size_t(own) + 1; k < i; ++k) between += order[k].pass == 1;
+        EXPECT_LE(between, 2);
+        for (size_t k = i + 1; k < order.size(); ++k)
+            if (order[k].pass == 1)
+                EXPECT_FALSE(order[k].y0 <= t.y1 && order[k].y1 >= t.y0 && order[k].x0 <= t.x1 &&
+                             order[k].x1 >= t.x0)
+                    << "pass-1 tile at " << order[k].x0 << "," << order[k].y0 << " after it";
+    }
+    EXPECT_EQ(superTiles, 10u * 5u);  // (150 / 16 rounded up, by 70 / 16 rounded up)
 }
 
 TEST(Render, AdaptiveSupersamplingChangesOnlyPixelsNextToAContrast) {

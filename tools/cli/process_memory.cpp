@@ -13,6 +13,7 @@ void fixMallocThresholds() {
     constexpr int kBytes = 128 * 1024;  // glibc's starting values of both
     mallopt(M_MMAP_THRESHOLD, kBytes);
     mallopt(M_TRIM_THRESHOLD, kBytes);
+    mallopt(M_TOP_PAD, kTopPadBytes);
 #endif
 }
 

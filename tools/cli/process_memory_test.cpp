@@ -38,6 +38,22 @@ TEST(ProcessMemory, AFreedLargeBlockDoesNotMoveTheNextIntoTheHeap) {
         EXPECT_EQ(mappedBytes(), before) << "round " << round;
     }
 }
+
+// A block freed at the top of the heap leaves the pad there: the next ones of its size
+// take pages already mapped, not fresh ones after a trim.
+TEST(ProcessMemory, TheHeapKeepsItsPadAtTheTop) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer's allocator replaces glibc's";
+#endif
+    fixMallocThresholds();
+    for (int round = 0; round < 3; ++round) {
+        void* volatile p = std::malloc(100 * 1024);  // (below the mmap threshold)
+        ASSERT_NE(p, nullptr);
+        std::memset(p, 1, 100 * 1024);
+        std::free(p);
+        EXPECT_GE(mallinfo2().keepcost, kTopPadBytes) << "round " << round;
+    }
+}
 #endif
 
 }  // namespace

@@ -78,9 +78,11 @@ class TileCosts:
         self.tx, self.ty = -(-width // TRACE_TILE), -(-height // TRACE_TILE)
         self.pass1 = [[0.0] * self.tx for _ in range(self.ty)]
         self.pass2 = [[0.0] * self.tx for _ in range(self.ty)]
-        for p, x0, y0, _x1, _y1, s in rows:
+        for p, x0, y0, _x1, y1, s in rows:
             grid = self.pass1 if p == 1 else self.pass2
-            grid[y0 // TRACE_TILE][x0 // TRACE_TILE] += s
+            # (by the tile's middle row: pass 2's tiles are the bands shifted up a row)
+            j = min(self.ty - 1, (y0 + y1) // 2 // TRACE_TILE)
+            grid[j][x0 // TRACE_TILE] += s
 
     def take_warmup(self, n):
         """Moves the n costliest tiles' excess over their neighbours' median into a
