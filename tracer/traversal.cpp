@@ -241,7 +241,7 @@ const UnrolledInstance* Tracer::unrolledAt(NodeId n, const Ctx& c, uint32_t dept
     if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->unrollAt(n, depth))
         return nullptr;
     if (!key) key = scene_.instanceBoxes_->keyOf(n, c.frame, c.path);
-    const UnrolledInstance* x = expansion_->meet(*key, n, depth, c.frame, c.path);
+    const UnrolledInstance* x = expansion_->meet(*key, n, depth, c.frame, c.path, anyHit_);
     // Used only where its deepest S-node stays within max_depth (else the walk reports it).
     if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
     if (x && anyHit_) occluder_.entering(n, depth, *key);

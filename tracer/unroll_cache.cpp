@@ -3,6 +3,7 @@
 
 #include <tbb/spin_rw_mutex.h>
 
+#include <algorithm>
 #include <deque>
 #include <unordered_map>
 
@@ -39,6 +40,9 @@ constexpr uint64_t kMisses = 256, kStandIns = 4;
 // 1/kGhostRate of the instances evicted so far: where they are fewer (a terrain's patches,
 // met again mostly far apart), the growth would buy few expansions for its bytes.
 constexpr uint64_t kGhostRate = 8;
+// A note's meetings, weighed: another ray's counts kMeeting, a shadow ray's kShadowMeeting;
+// the instance is expanded once they add up to two of the others' (kExpandAt).
+constexpr uint8_t kMeeting = 3, kShadowMeeting = 1, kExpandAt = 2 * kMeeting;
 // The bytes per node visit of an expansion: the estimate before the first one, and the
 // fewest, which bounds the visits of one (an expansion that reaches the limit is refused).
 constexpr double kFirstBytesPerVisit = 64;
@@ -52,6 +56,7 @@ struct UnrollCache::Entry {
     std::atomic<bool> referenced{false};               // used since the eviction hand passed
     std::shared_ptr<const UnrolledInstance> instance;  // Built (shared with a top level)
     size_t bytes = kNoteBytes;
+    uint8_t met = 0;   // a note's meetings so far, weighed (kMeeting, kShadowMeeting)
     size_t ghost = 0;  // a note left by an instance that was built and evicted: its bytes
 };
 
@@ -205,6 +210,7 @@ void UnrollCache::evict() {
                 evicted_.fetch_add(1, std::memory_order_relaxed);
                 e.bytes = 0;  // (a ghost's few bytes are not counted)
                 e.state = Entry::State::Note;
+                e.met = kMeeting;  // (met again, it is expanded again)
                 e.referenced.store(true, std::memory_order_relaxed);  // (a second round)
                 queue_.push_back(k);
                 continue;
@@ -297,8 +303,9 @@ const UnrolledInstance* UnrollCache::Reader::get(const InstanceBoxes::Key& key, 
 
 const UnrolledInstance* UnrollCache::Reader::meet(const InstanceBoxes::Key& key, NodeId select,
                                                   uint32_t depth, const double* frame,
-                                                  uint64_t path) {
+                                                  uint64_t path, bool shadow) {
     if (depth >= cache_.levels_) return nullptr;
+    const uint8_t weight = shadow ? kShadowMeeting : kMeeting;
     const size_t y = cache_.yieldIndex(select, depth);
     if (cache_.yield_[y].skipped(cache_.budget())) {
         missed(y);
@@ -314,6 +321,7 @@ const UnrolledInstance* UnrollCache::Reader::meet(const InstanceBoxes::Key& key,
         const auto it = emplaced.first;
         inserted = emplaced.second;
         if (inserted) {  // the first meeting: only a note
+            it->second.met = weight;
             cache_.bytes_.fetch_add(kNoteBytes, std::memory_order_relaxed);
             cache_.entries_.fetch_add(1, std::memory_order_relaxed);
         } else if (it->second.state == Entry::State::Built) {  // (built meanwhile)
@@ -321,7 +329,10 @@ const UnrolledInstance* UnrollCache::Reader::meet(const InstanceBoxes::Key& key,
             used(y);
             return it->second.instance.get();
         } else if (it->second.state == Entry::State::Note) {
-            if (cache_.stopsAt(y, select, depth, it->second.ghost, uses_[y])) return nullptr;
+            Entry& n = it->second;
+            n.met = static_cast<uint8_t>(std::min<int>(kExpandAt, n.met + weight));
+            if (n.met < kExpandAt) return nullptr;
+            if (cache_.stopsAt(y, select, depth, n.ghost, uses_[y])) return nullptr;
             it->second.state = Entry::State::Building;  // the second meeting: expand
             if (it->second.ghost > 0) cache_.unghost(it->second);
             e = &it->second;

@@ -10,8 +10,12 @@
 //    top level (top_level.h) shares instances with the cache (share()): one it holds
 //    lives on after the cache evicts it, and is freed with the top level.
 //  - Notes: the first meeting of an instance, by any thread, leaves a note; the second,
-//    by any thread, expands it. While one thread expands an instance it is marked "in
-//    construction", and the others walk the graph below it meanwhile, not wait.
+//    by any thread, expands it. A shadow ray's meeting counts a third of one: an instance
+//    that only a camera ray and its shadow rays meet (a terrain's far patch, seen by one
+//    pixel, its shadow rays starting inside it) stays a note and is walked, and one that
+//    only shadow rays meet (a caster out of view) is expanded at their sixth meeting. While one
+//    thread expands an instance it is marked "in construction", and the others walk the graph below
+//    it meanwhile, not wait.
 //  - Eviction: second chance (CLOCK) over all entries, in the order of insertion, until
 //    the notes and instances fit the budget again; an instance in construction stays,
 //    and the one just built gets its second chance.
@@ -190,9 +194,10 @@ class UnrollCache::Reader {
     const UnrolledInstance* built(const InstanceBoxes::Key& key, NodeId select, uint32_t depth);
     // get() for an instance that built() has just not found (the walk asks built() first,
     // then tests the instance's box): its meeting, which leaves a note or expands it, without
-    // looking for it as a built one again. The same result as get().
+    // looking for it as a built one again. The same result as get(). A shadow ray's meeting
+    // counts a third of another ray's (see Notes above).
     const UnrolledInstance* meet(const InstanceBoxes::Key& key, NodeId select, uint32_t depth,
-                                 const double* frame, uint64_t path);
+                                 const double* frame, uint64_t path, bool shadow = false);
 
     UnrolledInstance::Scratch& scratch() { return scratch_; }
     uint64_t expansions() const { return expansions_; }  // made by this thread

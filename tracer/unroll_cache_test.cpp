@@ -167,6 +167,34 @@ TEST(UnrollCache, BuiltFindsTheBuiltInstancesAndItsFilterForgetsTheEvictedOnes) 
     EXPECT_FALSE(cache.mayBeBuilt(k));
 }
 
+// A shadow ray's meeting counts a third of another ray's: a camera ray's note and two
+// shadow rays leave a note; six shadow rays, or two other rays, expand the instance.
+TEST(UnrollCache, AShadowRaysMeetingCountsAThirdOfOne) {
+    auto c = compile(kFlower);
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
+    Flower f(*c->graph);
+    ASSERT_NE(f.slot, SIZE_MAX);
+    UnrollCache cache(scene, 8 * (flowerBytes(scene, f, 21) + 256));
+    UnrollCache::Reader r(cache);
+    const UnrollCache::Pin pin(&r);
+    auto meet = [&](double petals, bool shadow) {
+        f.frame[f.slot] = petals;
+        const InstanceBoxes::Key k =
+            scene.instanceBoxes()->keyOf(f.select, f.frame.data(), kRootPath);
+        return r.meet(k, f.select, 1, f.frame.data(), kRootPath, shadow);
+    };
+    EXPECT_EQ(meet(21, false), nullptr);
+    EXPECT_EQ(meet(21, true), nullptr);
+    EXPECT_EQ(meet(21, true), nullptr);
+    EXPECT_NE(meet(21, false), nullptr);
+    for (int ray = 0; ray < 5; ++ray) EXPECT_EQ(meet(20, true), nullptr) << "shadow ray " << ray;
+    EXPECT_NE(meet(20, true), nullptr);
+    EXPECT_EQ(meet(19, false), nullptr);
+    EXPECT_NE(meet(19, false), nullptr);
+    EXPECT_EQ(cache.expansions(), 3u);
+}
+
 TEST(UnrollCache, TracersOnSeveralThreadsStayWithinOneBudgetAndFindTheGraphWalksHits) {
     auto c = compile(kPlant);
     ASSERT_TRUE(c->graph);
