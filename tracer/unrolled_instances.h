@@ -17,7 +17,8 @@
 //    few dozen to a thousand node visits (InstanceBoxes::unrollAt); the first S-node of
 //    such a depth on a ray's path is expanded with everything below it.
 //  - When: an instance is expanded the second time it is met, by any thread (the first
-//    time only leaves a note), so that instances a single ray passes do not pay for it; and
+//    time only leaves a note; a shadow ray's meeting counts a third of one, unroll_cache.h),
+//    so that instances a single ray passes do not pay for it; and
 //    expansion stops at a depth where the expansions are not used several times each (a
 //    terrain's sub-triangles, each seen by a few rays only).
 //  - Where: in one cache shared by the tracer threads (unroll_cache.h), within a byte
