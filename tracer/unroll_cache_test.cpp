@@ -133,14 +133,29 @@ TEST(UnrollCache, AnInstanceEvictedWhileInUseStaysIntactUntilItsReaderUnpins) {
     EXPECT_EQ(cache.retiredBytes(), 0u);
 }
 
+// The flower's scene, its instances and a cache that holds eight of them, read by r.
+struct FlowerCache {
+    explicit FlowerCache(const Graph& g)
+        : scene(g, computeBounds(g), true, eagerExpansion()),
+          f(g),
+          cache(scene,
+                f.slot == SIZE_MAX ? size_t{1} << 20 : 8 * (flowerBytes(scene, f, 21) + 256)),
+          r(cache) {}
+    TraceScene scene;
+    Flower f;
+    UnrollCache cache;
+    UnrollCache::Reader r;
+};
+
 TEST(UnrollCache, BuiltFindsTheBuiltInstancesAndItsFilterForgetsTheEvictedOnes) {
     auto c = compile(kFlower);
     ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
-    Flower f(*c->graph);
+    FlowerCache fc(*c->graph);
+    TraceScene& scene = fc.scene;
+    Flower& f = fc.f;
+    UnrollCache& cache = fc.cache;
+    UnrollCache::Reader& r = fc.r;
     ASSERT_NE(f.slot, SIZE_MAX);
-    UnrollCache cache(scene, 8 * (flowerBytes(scene, f, 21) + 256));
-    UnrollCache::Reader r(cache);
     f.frame[f.slot] = 21;
     const InstanceBoxes::Key k = scene.instanceBoxes()->keyOf(f.select, f.frame.data(), kRootPath);
     const UnrolledInstance* x = nullptr;
@@ -172,17 +187,15 @@ TEST(UnrollCache, BuiltFindsTheBuiltInstancesAndItsFilterForgetsTheEvictedOnes) 
 TEST(UnrollCache, AShadowRaysMeetingCountsAThirdOfOne) {
     auto c = compile(kFlower);
     ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
-    Flower f(*c->graph);
-    ASSERT_NE(f.slot, SIZE_MAX);
-    UnrollCache cache(scene, 8 * (flowerBytes(scene, f, 21) + 256));
-    UnrollCache::Reader r(cache);
-    const UnrollCache::Pin pin(&r);
-    auto meet = [&](double petals, bool shadow) {
+    FlowerCache fc(*c->graph);
+    ASSERT_NE(fc.f.slot, SIZE_MAX);
+    const UnrollCache::Pin pin(&fc.r);
+    auto meet = [&fc](double petals, bool shadow) {
+        Flower& f = fc.f;
         f.frame[f.slot] = petals;
         const InstanceBoxes::Key k =
-            scene.instanceBoxes()->keyOf(f.select, f.frame.data(), kRootPath);
-        return r.meet(k, f.select, 1, f.frame.data(), kRootPath, shadow);
+            fc.scene.instanceBoxes()->keyOf(f.select, f.frame.data(), kRootPath);
+        return fc.r.meet(k, f.select, 1, f.frame.data(), kRootPath, shadow);
     };
     EXPECT_EQ(meet(21, false), nullptr);
     EXPECT_EQ(meet(21, true), nullptr);
@@ -192,7 +205,7 @@ TEST(UnrollCache, AShadowRaysMeetingCountsAThirdOfOne) {
     EXPECT_NE(meet(20, true), nullptr);
     EXPECT_EQ(meet(19, false), nullptr);
     EXPECT_NE(meet(19, false), nullptr);
-    EXPECT_EQ(cache.expansions(), 3u);
+    EXPECT_EQ(fc.cache.expansions(), 3u);
 }
 
 TEST(UnrollCache, TracersOnSeveralThreadsStayWithinOneBudgetAndFindTheGraphWalksHits) {
