@@ -467,7 +467,8 @@ namespace {
 // machine; where it stops (an unassigned read), the arguments are evaluated one by one,
 // which reports the first error as it always did. A lone leaf is read here, anything else
 // through evalExpr() (out of line: the leaves' path keeps a small frame).
-void argumentsOf(const Graph& g, const Transform& t, EvalState s, double* a) {
+[[gnu::noinline]] void argumentsInGeneral(const Graph& g, const Transform& t, EvalState s,
+                                          double* a) {
     double unused;
     const bool all = t.fast != kNoFast && runFast(g, t.fast, s.frame, a, s.path, unused);
     for (uint32_t i = 0; i < t.argCount; ++i) {
@@ -476,6 +477,19 @@ void argumentsOf(const Graph& g, const Transform& t, EvalState s, double* a) {
         if (!std::isfinite(a[i]))
             nonFinite(g, g.exprs[id], a[i], "the transformation argument", s.frame);
     }
+}
+
+// The same, first tried for a T-node with no program (all its arguments lone leaves, as
+// move(0, 0, z1)) without a call: no registers saved, the loop only reads. Where a leaf is
+// unassigned or a value not finite, argumentsInGeneral() starts again and reports it.
+void argumentsOf(const Graph& g, const Transform& t, EvalState s, double* a) {
+    if (t.fast == kNoFast) {
+        const ExprId* ids = g.args.data() + t.firstArg;
+        uint32_t i = 0;
+        while (i < t.argCount && leafOf(g, g.exprs[ids[i]], s, a[i]) && std::isfinite(a[i])) ++i;
+        if (i == t.argCount) return;
+    }
+    argumentsInGeneral(g, t, s, a);
 }
 
 // A T-node's arguments, checked, and its matrix. move() and zshear() of finite arguments

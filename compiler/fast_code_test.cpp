@@ -427,6 +427,38 @@ TEST(FastCode, ATNodesArgumentsAsOneProgramGiveEachArgumentsValueBitForBit) {
     EXPECT_GT(errors, 500u) << "the non-finite and unassigned arguments' errors are compared";
 }
 
+// A T-node of lone leaves has no program: its arguments are read without a call, and an
+// unassigned or non-finite one is reported as the plain code reports it.
+TEST(FastCode, ATNodesLoneLeavesAreReadOrReportedAsThePlainCodeDoes) {
+    auto c = testing::compileUnfolded("{x = 1; y = 2} (move(x, w, 0) sphere ∪ {w = 0} cube)\n");
+    ASSERT_TRUE(c->graph) << c->errors();
+    const Graph& g = *c->graph;
+    const Graph plain = plainOf(g);
+    NodeId move = kNone;
+    for (NodeId n = 0; n < g.nodes.size(); ++n)
+        if (g.nodes[n].kind == NodeKind::Transform) move = n;
+    ASSERT_NE(move, kNone);
+    ASSERT_EQ(g.transforms[g.nodes[move].payload].fast, kNoFast);
+    std::vector<double> frame(g.slotCount());
+    const auto at = [&](const char* name) -> double& {
+        return frame[std::find(g.slotNames.begin(), g.slotNames.end(), name) - g.slotNames.begin()];
+    };
+    size_t errors = 0;
+    for (double x : {1.5, -0.0, kInf, -kInf, std::nan("")}) {
+        for (bool assigned : {false, true}) {
+            initFrame(g, frame.data());
+            at("x") = x;
+            if (assigned) at("w") = -2;
+            const EvalState s{frame.data(), kRootPath};
+            const auto got = pairOf(g, move, s);
+            errors += !got.first.empty();
+            EXPECT_EQ(got, pairOf(plain, move, s)) << x << " " << assigned;
+            if (std::isfinite(x) && assigned) EXPECT_EQ(got.second[9], std::bit_cast<uint64_t>(x));
+        }
+    }
+    EXPECT_EQ(errors, 8u) << "w unassigned, or x not finite";
+}
+
 TEST(FastCode, ATNodesProgramStoresEveryArgument) {
     auto c = testing::compileUnfolded(kTransforms);
     ASSERT_TRUE(c->graph) << c->errors();
