@@ -453,7 +453,9 @@ TEST(FastCode, ATNodesLoneLeavesAreReadOrReportedAsThePlainCodeDoes) {
             const auto got = pairOf(g, move, s);
             errors += !got.first.empty();
             EXPECT_EQ(got, pairOf(plain, move, s)) << x << " " << assigned;
-            if (std::isfinite(x) && assigned) EXPECT_EQ(got.second[9], std::bit_cast<uint64_t>(x));
+            if (std::isfinite(x) && assigned) {
+                EXPECT_EQ(got.second[9], std::bit_cast<uint64_t>(x));
+            }
         }
     }
     EXPECT_EQ(errors, 8u) << "w unassigned, or x not finite";

@@ -303,11 +303,11 @@ TEST(Render, SupersamplingFollowsPassOneTwoTilesBehind) {
         int between = 0;
         for (size_t k = size_t(own) + 1; k < i; ++k) between += order[k].pass == 1;
         EXPECT_LE(between, 2);
-        for (size_t k = i + 1; k < order.size(); ++k)
-            if (order[k].pass == 1)
-                EXPECT_FALSE(order[k].y0 <= t.y1 && order[k].y1 >= t.y0 && order[k].x0 <= t.x1 &&
-                             order[k].x1 >= t.x0)
-                    << "pass-1 tile at " << order[k].x0 << "," << order[k].y0 << " after it";
+        for (size_t k = i + 1; k < order.size(); ++k) {
+            const Tile& p = order[k];
+            const bool read = p.y0 <= t.y1 && p.y1 >= t.y0 && p.x0 <= t.x1 && p.x1 >= t.x0;
+            EXPECT_FALSE(p.pass == 1 && read) << "pass-1 tile at " << p.x0 << "," << p.y0;
+        }
     }
     EXPECT_EQ(superTiles, 10u * 5u);  // (150 / 16 rounded up, by 70 / 16 rounded up)
 }
