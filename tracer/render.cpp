@@ -134,9 +134,9 @@ class TileRender {
     }
 
   private:
-    // The decision between the passes, and the hand-over of finished rows to the sink: not
-    // passes of their own for tileTime and progress.
-    static constexpr int kEmit = 3;  // (passes 1 and 2 are the samples)
+    // The hand-over of finished rows to the sink: not a pass of its own for tileTime and
+    // progress (passes 1 and 2 are the samples; pass 2 decides its pixels too).
+    static constexpr int kEmit = 3;
     // The rows of the image kept at once (the window): those of the band in pass 1 with
     // the border rows above and below it, and the rows decided in the step before, which
     // are being handed over. (34 are in use at most: the last band's border row below is

@@ -333,9 +333,9 @@ const UnrolledInstance* UnrollCache::Reader::meet(const InstanceBoxes::Key& key,
             n.met = static_cast<uint8_t>(std::min<int>(kExpandAt, n.met + weight));
             if (n.met < kExpandAt) return nullptr;
             if (cache_.stopsAt(y, select, depth, n.ghost, uses_[y])) return nullptr;
-            it->second.state = Entry::State::Building;  // the second meeting: expand
-            if (it->second.ghost > 0) cache_.unghost(it->second);
-            e = &it->second;
+            n.state = Entry::State::Building;  // met enough: expand
+            if (n.ghost > 0) cache_.unghost(n);
+            e = &n;
         }
     }
     if (!e) {

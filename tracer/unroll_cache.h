@@ -13,9 +13,9 @@
 //    by any thread, expands it. A shadow ray's meeting counts a third of one: an instance
 //    that only a camera ray and its shadow rays meet (a terrain's far patch, seen by one
 //    pixel, its shadow rays starting inside it) stays a note and is walked, and one that
-//    only shadow rays meet (a caster out of view) is expanded at their sixth meeting. While one
-//    thread expands an instance it is marked "in construction", and the others walk the graph below
-//    it meanwhile, not wait.
+//    only shadow rays meet (a caster out of view) is expanded at their sixth meeting.
+//    While one thread expands an instance it is marked "in construction", and the others
+//    walk the graph below it meanwhile, not wait.
 //  - Eviction: second chance (CLOCK) over all entries, in the order of insertion, until
 //    the notes and instances fit the budget again; an instance in construction stays,
 //    and the one just built gets its second chance.
