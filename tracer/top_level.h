@@ -18,13 +18,28 @@
 //    an expanded instance (InstanceBoxes::unrollAt) and the expansion cache has built
 //    instances of that (module, depth) without refusing one as too large; elsewhere it
 //    expands in place. Copies are shared by their instance key (and depth).
-//  - When it is refused (nullptr, the walk as before): an operator other than a union
-//    above the cuts, a paint node whose pattern needs its frame, a level where the cache
-//    stopped expanding (a terrain's patches, each used by a few rays: every instance
-//    unique), more than half as many instances as copies, more than `maxBytes` in all
-//    (top and instances), more node visits above the cuts than kMaxVisits and a few per
-//    copy met (see below), an instance whose deepest S-node passes max_depth, or a
-//    run-time error (the walk raises it where a ray meets it).
+//  - When it is refused (then tried with deferred cuts, below): an operator other than a
+//    union above the cuts, a paint node whose pattern needs its frame, a level where the
+//    cache stopped expanding, more than half as many instances as copies (a terrain's
+//    patches: every instance unique), more than `maxBytes` in all (top and instances),
+//    more node visits above the cuts than kMaxVisits and a few per copy met (see below),
+//    an instance whose deepest S-node passes max_depth, or a run-time error (the walk
+//    raises it where a ray meets it). Not tried again with deferred cuts: a dry run refused
+//    while its copies were many and their instances few (a larger instance will do).
+//  - Deferred cuts (unique instances: a terrain's patches, a conifer's branches): the same
+//    expansion, cut at the first S-node on a path where the tracer would hand the ray to an
+//    expanded instance and the cache expands that depth (for any module, and has not
+//    stopped for this one), whether or not it has built this instance. The cut is a node
+//    of kind Deferred: the S-node, its state (the parameters, copied; the instance path;
+//    the depth) and its key, under the instance's exact box (InstanceBoxes). A ray that
+//    meets its box is handed to the tracer (Tracer::firstDeferred), which does there what
+//    the walk does at that S-node once its boxes let the ray through: the cache's
+//    expansion (a meeting as the walk's, so the cache goes on learning and expanding), or
+//    the walk below it. So a ray reaches the patch it meets through one hierarchy instead
+//    of the walk of every level above it (the terrain: 50 M node visits at 640x480 became
+//    7 M). Refused where a paint node's material needs its frame (the walk below a
+//    deferred node does not have the matrices above it), where the cache expands nowhere,
+//    or past maxBytes / kBytesPerDeferredVisit node visits or `maxBytes`.
 //  - When it is built: by TraceScene::buildTopLevel, which a tracer calls once the
 //    expansion cache has seen a few thousand rays enter the scene (so that the cuts are
 //    known); per TraceScene, so per frame of a sequence. Immutable once built.
@@ -62,7 +77,9 @@ class TopLevel {
     static std::unique_ptr<TopLevel> build(const TraceScene& scene, const UnrollCache& cache,
                                            size_t maxBytes, bool* manyCopies = nullptr);
 
-    // The nearest surface as Tracer::first from the axiom finds it (world ray).
+    // The nearest surface as Tracer::first from the axiom finds it (world ray). With
+    // deferred() nodes, `s` must be the scratch of a tracer's expansion cache reader (its
+    // walker walks them).
     bool first(const LocalRay& r, double tmin, double& tmax, Hit& hit, bool anyHit,
                UnrolledInstance::Scratch& s) const {
         return top_->first(r, tmin, tmax, hit, {kRootPath, 0, 0}, anyHit, s);
@@ -75,8 +92,17 @@ class TopLevel {
     size_t sharedInstances() const { return shared_; }
     const UnrolledInstance& instance(size_t i) const { return *owned_[i]; }
 
+    // Deferred nodes (the top level of a scene whose instances are all but unique).
+    size_t deferred() const { return top_ ? top_->deferredNodes() : 0; }
+
   private:
     class Cuts;
+    class DeferredCuts;
+    // The node visits of a top level with deferred cuts: one per this many bytes of the
+    // budget (262,144 in 16 MB; the terrain's top level, 8,192 cuts, takes 3.6 MB).
+    static constexpr size_t kBytesPerDeferredVisit = 64;
+    static std::unique_ptr<TopLevel> buildDeferred(const TraceScene& scene,
+                                                   const UnrollCache& cache, size_t maxBytes);
     // The instances the copies refer to: the expansion cache's where it had built them
     // (which stay valid here when the cache evicts them), else the top level's own.
     std::vector<std::shared_ptr<const UnrolledInstance>> owned_;

@@ -1,13 +1,16 @@
 // The two-level structure (top_level.h): for many random rays it finds the graph walk's
-// hits exactly (t, normal, instance path, material), shadow rays included; copies share
-// their instances, with the expansion cache; it is refused where the part above the cuts is not all
-// unions.
+// hits exactly (t, normal, instance path, material, paint point), shadow rays included;
+// copies share their instances, with the expansion cache; where the instances are all but
+// unique (a terrain's patches) its cuts are deferred to the tracer, which still feeds the
+// cache; it is refused where the part above the cuts is not all unions.
 #include "top_level.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
 
 #include "bounds.h"
 #include "test_support.h"
@@ -68,8 +71,39 @@ T if(n > 0, 2, 1)
 2: T -> {n = n-1; h = 2*h} move(1,0,0) uscale(0.5) T ∪ {n = n-1; h = 2*h+1} move(-1,0,0) uscale(0.5) T
 )";
 
+// kUnique painted: copies in two materials above the cuts (red and the default), unique too.
+const char* kUniquePainted = R"(
+material red { color <1,0,0> }
+{n = 5; h = 1} (paint(red) T ∪ {h = h + 64} move(0,0,-1.5) T)
+T if(n > 0, 2, 1)
+1: T -> move(0,0,h*0.01) scale(1.5, 20, 20) sphere
+2: T -> {n = n-1; h = 2*h} move(1,0,0) uscale(0.5) T ∪ {n = n-1; h = 2*h+1} move(-1,0,0) uscale(0.5) T
+)";
+
+// kUnique with a pattern below the cuts: the walk records the frames of paint nodes, which a
+// deferred node's walk, started below the root, does not see whole: no top level.
+const char* kUniqueBumpy = R"(
+material bumpy { color <1,0,0>  normal { bumps 0.5 scale 0.1 } }
+{n = 5; h = 1} T
+T if(n > 0, 2, 1)
+1: T -> paint(bumpy) move(0,0,h*0.01) scale(1.5, 20, 20) sphere
+2: T -> {n = n-1; h = 2*h} move(1,0,0) uscale(0.5) T ∪ {n = n-1; h = 2*h+1} move(-1,0,0) uscale(0.5) T
+)";
+
+// The scene file scenes/terrain.pcsg at order `order` (its cnt) instead of 10.
+std::string terrain(int order) {
+    std::ifstream in(std::string(PCSG_SCENES_DIR) + "/terrain.pcsg");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    const size_t at = s.find("cnt = 10;");
+    if (at == std::string::npos) return "";
+    return s.replace(at, 9, "cnt = " + std::to_string(order) + ";");
+}
+
 struct Result {
-    size_t copies = 0, instances = 0, hits = 0;
+    size_t copies = 0, instances = 0, deferred = 0, hits = 0;
+    uint64_t expansionsAfter = 0;  // made while the rays were fired through the top level
     bool built = false;
 };
 
@@ -77,9 +111,8 @@ struct Result {
 // learns where it expands), then builds the top level and fires them again, comparing
 // every first hit and shadow ray with a scene that only walks the graph. `expansionBytes`:
 // the budget of the expansion cache (and of the top level).
-Result compareWithGraphWalk(const std::string& text, int n, double spread,
-                            size_t expansionBytes = 16u << 20,
-                            const InstanceBoxOptions& options = eagerExpansion()) {
+Result compareRays(const std::string& text, const std::vector<Vec3>& o, const std::vector<Vec3>& d,
+                   size_t expansionBytes, const InstanceBoxOptions& options) {
     Result out;
     auto c = compile(text);
     if (!c->graph) return out;
@@ -89,20 +122,15 @@ Result compareWithGraphWalk(const std::string& text, int n, double spread,
     TraceScene twoLevel(g, computeBounds(g), true, options);
     twoLevel.expansionBytes = expansionBytes;
     Tracer a(plain), b(twoLevel);
-    std::mt19937_64 rng(11);
-    std::uniform_real_distribution<double> u(-1, 1);
-    std::vector<Vec3> o, d;
-    for (int i = 0; i < n; ++i) {
-        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
-        const Vec3 target{u(rng) * spread, u(rng) * spread, u(rng) * spread + 0.5};
-        d.push_back(normalize(target - o.back()));
-    }
+    const int n = static_cast<int>(o.size());
     SurfaceHit warm;
     for (int round = 0; round < 2; ++round)
         for (int i = 0; i < n; ++i) b.firstHit(o[i], d[i], 1e-4, 1e7, warm);
     const TopLevel* top = twoLevel.buildTopLevel();
     out.built = top != nullptr;
     if (top) out.copies = top->copies(), out.instances = top->instances();
+    if (top) out.deferred = top->deferred();
+    const uint64_t expansionsBefore = b.expansions();
     for (int i = 0; i < n; ++i) {
         SurfaceHit ha, hb;
         const bool fa = a.firstHit(o[i], d[i], 1e-4, 1e7, ha);
@@ -119,8 +147,27 @@ Result compareWithGraphWalk(const std::string& text, int n, double spread,
         EXPECT_EQ(ha.normal, hb.normal) << "ray " << i;
         EXPECT_EQ(ha.path, hb.path) << "ray " << i;
         EXPECT_EQ(ha.material, hb.material) << "ray " << i;
+        EXPECT_EQ(ha.painted, hb.painted) << "ray " << i;
+        if (ha.painted) EXPECT_EQ(ha.paintPoint, hb.paintPoint) << "ray " << i;
     }
+    out.expansionsAfter = b.expansions() - expansionsBefore;
     return out;
+}
+
+// compareRays with n random rays from in front of the scene towards the box of half-size
+// `spread` around (0, 0, 0.5).
+Result compareWithGraphWalk(const std::string& text, int n, double spread,
+                            size_t expansionBytes = 16u << 20,
+                            const InstanceBoxOptions& options = eagerExpansion()) {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<Vec3> o, d;
+    for (int i = 0; i < n; ++i) {
+        o.push_back({u(rng) * 5, -6 + u(rng), u(rng) * 5});
+        const Vec3 target{u(rng) * spread, u(rng) * spread, u(rng) * spread + 0.5};
+        d.push_back(normalize(target - o.back()));
+    }
+    return compareRays(text, o, d, expansionBytes, options);
 }
 
 TEST(TopLevel, SierpinskiCopiesShareTheirInstanceAndHitTheWalksSurfaces) {
@@ -164,11 +211,46 @@ TEST(TopLevel, InstancesWithTheirOwnMatricesAndPaintAtTheRootHitTheWalksSurfaces
     EXPECT_GT(r.hits, 300u);
 }
 
-TEST(TopLevel, UniqueInstancesAreLeftToTheWalk) {
+TEST(TopLevel, UniqueInstancesAreDeferredToTheWalkAndHitItsSurfaces) {
     // (a budget that holds only the deeper levels: many copies, each its own instance)
     const Result r = compareWithGraphWalk(kUnique, 1500, 1.5, 64u << 10);
+    ASSERT_TRUE(r.built);
+    EXPECT_EQ(r.instances, 0u);
+    EXPECT_GE(r.deferred, 4u);
+    EXPECT_EQ(r.copies, r.deferred);
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, DeferredNodesTakeTheirCopiesMaterials) {
+    const Result r = compareWithGraphWalk(kUniquePainted, 1500, 1.5, 64u << 10);
+    ASSERT_TRUE(r.built);
+    EXPECT_GE(r.deferred, 8u);
+    EXPECT_GT(r.hits, 300u);
+}
+
+TEST(TopLevel, APatternBelowUniqueInstancesLeavesThemToTheWalk) {
+    const Result r = compareWithGraphWalk(kUniqueBumpy, 1500, 1.5, 64u << 10);
     EXPECT_FALSE(r.built);
     EXPECT_GT(r.hits, 300u);
+}
+
+// The terrain's patches: one deferred node each where the cache expands them, whose rays
+// still meet them in the cache (and expand those met twice).
+TEST(TopLevel, TerrainPatchesAreDeferredAndStillExpandedByTheCache) {
+    const std::string text = terrain(6);
+    ASSERT_FALSE(text.empty());
+    // A camera's rays (as the scene's, rows of neighbours that meet the same patches).
+    std::vector<Vec3> o, d;
+    for (int y = 0; y < 80; ++y)
+        for (int x = 0; x < 80; ++x) {
+            o.push_back({-0.75, -1.05, 1.0});
+            d.push_back(normalize(Vec3{0.2 + x / 60.0, 0.2 + y / 60.0, -0.05} - o.back()));
+        }
+    const Result r = compareRays(text, o, d, 1u << 20, InstanceBoxOptions{});
+    ASSERT_TRUE(r.built);
+    EXPECT_GE(r.deferred, 32u);
+    EXPECT_GT(r.expansionsAfter, 0u);
+    EXPECT_GT(r.hits, 1000u);
 }
 
 TEST(TopLevel, ADifferenceAboveTheInstancesFallsBackToTheWalk) {

@@ -182,8 +182,10 @@ Tracer::Tracer(const TraceScene& scene)
     if (scene.instanceBoxes_) boxWorker_ = scene.instanceBoxes_->makeWorker();
     if (scene.stepMemoLog2 > 0)
         memo_ = std::make_unique<StepMemo>(g_, scene.memoPlan_, scene.stepMemoLog2);
-    if (scene.instanceBoxes_ && scene.expansionBytes > 0)
+    if (scene.instanceBoxes_ && scene.expansionBytes > 0) {
         expansion_ = std::make_unique<UnrollCache::Reader>(scene.expansionCache());
+        expansion_->scratch().walker = this;
+    }
 }
 
 Tracer::~Tracer() = default;
@@ -255,7 +257,7 @@ const UnrolledInstance* Tracer::builtAt(NodeId n, const Ctx& c, uint32_t depth,
                                         std::optional<InstanceBoxes::Key>& key) {
     if (!expansion_ || !scene_.useBounds || !scene_.instanceBoxes_->unrollAt(n, depth))
         return nullptr;
-    key = scene_.instanceBoxes_->keyOf(n, c.frame, c.path);
+    if (!key) key = scene_.instanceBoxes_->keyOf(n, c.frame, c.path);
     const UnrolledInstance* x = expansion_->built(*key, n, depth);
     if (x && depth + x->levels() > g_.scene.settings.maxDepth) return nullptr;
     if (x && anyHit_) occluder_.entering(n, depth, *key);
@@ -298,18 +300,19 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     const LocalRay r{origin, dir};
     Hit hit;
     double best = tmax;
+    // The graph walk's own stacks (also below a top level's Deferred nodes; the top level's
+    // walk keeps its state in the expansions' scratch, and its hits have no paint frame of
+    // the graph walk's).
+    frames_.reset();
+    spans_.clear();
+    order_.clear();
+    paintRays_.clear();
+    paintInteriors_.clear();
+    paintMaps_.clear();
+    inverses_.clear();
     if (const TopLevel* top = topLevel()) {
         if (!top->first(r, tmin, best, hit, anyHit_, expansion_->scratch())) return false;
     } else {
-        // The graph walk's own stacks (the top level's walk keeps its state in the
-        // expansions' scratch, and its hits have no paint frame of the graph walk's).
-        frames_.reset();
-        spans_.clear();
-        order_.clear();
-        paintRays_.clear();
-        paintInteriors_.clear();
-        paintMaps_.clear();
-        inverses_.clear();
         if (anyHit_ && expansion_ &&
             occluder_.occludes(*expansion_, g_.scene.settings.maxDepth, r, tmin, tmax))
             return true;
@@ -344,6 +347,33 @@ bool Tracer::anyHit(const Vec3& origin, const Vec3& dir, double tmin, double tma
     anyHit_ = true;
     SurfaceHit hit;
     return walk(origin, dir, tmin, tmax, hit);
+}
+
+// A top level's Deferred node (top_level.h): its S-node instance, the ray in the S-node's
+// frame, as unary() hands it on once the instance's boxes have let it through (the top
+// level's hierarchy tested the exact box): expanded, or the walk below the S-node. (No
+// last occluder: the walk from the root, which would try it, is the top level's now.)
+bool Tracer::firstDeferred(const UnrolledInstance::Deferred& d, const double* frame,
+                           const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                           uint32_t material) {
+    const Ctx c{frame, d.path, d.stateDepth, material, 0};
+    std::optional<InstanceBoxes::Key> key = d.key;
+    try {
+        checkStack();
+        const UnrolledInstance* x = builtAt(d.select, c, d.depth, key);
+        if (!x) x = unrolledAt(d.select, c, d.depth, key);
+        if (x)
+            return x->first(r, tmin, tmax, hit, {c.path, c.material, 0}, anyHit_,
+                            expansion_->scratch());
+        StepScratch scratch;
+        scratch.memo = memo_.get();
+        const Step st = scene_.sem_.enter(d.select, c, scratch);
+        return first(st.child, r, st.state, tmin, tmax, hit,
+                     operandBoxesOf(d.select, *key, d.depth, st));
+    } catch (RuntimeError& e) {
+        e.enterModule(g_.modules[g_.nodes[d.select].payload].name);
+        throw;
+    }
 }
 
 // The unary nodes on the way down, shared by first() and spans(): the one step of

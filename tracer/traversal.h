@@ -24,7 +24,9 @@
 //  - Above the depth where instances are expanded, once the cache knows that depth, a ray
 //    is traced through the two-level structure of top_level.h instead of the walk: an
 //    expansion of the graph from the axiom whose leaves are the copies of shared expanded
-//    instances (the same matrices, the same surfaces bit for bit).
+//    instances (the same matrices, the same surfaces bit for bit), or, where instances
+//    are unique (a terrain's patches), whose leaves are deferred to this walk: the walk
+//    resumes at such an S-node from the state stored there (Tracer::firstDeferred).
 //  - Pattern space (docs/language.md section 10): a pattern lives in the frame of the paint
 //    node that applied it. Where a paint node's material has a pattern (only then), the
 //    walk records the ray as that node's frame sees it, and the hit's point in that frame
@@ -188,8 +190,9 @@ class StackExhausted : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Per-thread walker: reuse one for all the rays of a thread.
-class Tracer {
+// Per-thread walker: reuse one for all the rays of a thread. (It walks the Deferred nodes
+// of a top level too, as the walker of its expansions' scratch space.)
+class Tracer final : private UnrolledInstance::Walker {
   public:
     explicit Tracer(const TraceScene& scene);
     ~Tracer();
@@ -267,6 +270,8 @@ class Tracer {
     auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
                Unrolled unrolled, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
+    bool firstDeferred(const UnrolledInstance::Deferred& d, const double* frame, const LocalRay& r,
+                       double tmin, double& tmax, Hit& hit, uint32_t material) override;
     const TopLevel* topLevel();
     void checkStack() {  // (inline: once per S-node visit)
         const auto here = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));

@@ -291,6 +291,10 @@ class Unroller {
                 const uint32_t depth = sem_.selectDepth(n, s);
                 if (const UnrolledInstance* x = cuts_->cut(n, s, depth))
                     return buildReference(*x, s, pendingBase, edge);
+                Box box;
+                InstanceBoxes::Key key;
+                if (cuts_->defer(n, s, depth, box, key))
+                    return buildDeferred(n, s, depth, box, key, pendingBase, edge);
             }
             return buildUnary(n, s, pendingBase, edge);
         } catch (RuntimeError& e) {
@@ -386,6 +390,20 @@ class Unroller {
         Node r = emit(Kind::Instance, s.material, pendingBase, edge, x.box());
         r.first = static_cast<uint32_t>(out_.instances_.size());
         out_.instances_.push_back({&x, s.path});
+        out_.nodes_.push_back(r);
+        return static_cast<uint32_t>(out_.nodes_.size() - 1);
+    }
+
+    // A deferred cut (expandTop): the S-node instance entered in state s, whose box in its
+    // own frame is `box`, stays the tracer's to walk.
+    uint32_t buildDeferred(NodeId n, const PathState& s, uint32_t depth, const Box& box,
+                           const InstanceBoxes::Key& key, size_t pendingBase, const Affine* edge) {
+        if (box.isEmpty()) return kNone;
+        Node r = emit(Kind::Deferred, s.material, pendingBase, edge, box);
+        r.first = static_cast<uint32_t>(out_.deferred_.size());
+        const auto frame = static_cast<uint32_t>(out_.deferredFrames_.size());
+        out_.deferred_.push_back({n, depth, s.depth, frame, s.path, key});
+        out_.deferredFrames_.insert(out_.deferredFrames_.end(), s.frame, s.frame + g_.slotCount());
         out_.nodes_.push_back(r);
         return static_cast<uint32_t>(out_.nodes_.size() - 1);
     }
@@ -724,7 +742,8 @@ size_t UnrolledInstance::bytes() const {
            children_.capacity() * sizeof(uint32_t) + matrices_.capacity() * sizeof(Affine) +
            matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) +
            choices_.capacity() * sizeof(uint32_t) + bvh_.capacity() * sizeof(BvhNode) +
-           links_.capacity() * sizeof(Link) + instances_.capacity() * sizeof(Reference);
+           links_.capacity() * sizeof(Link) + instances_.capacity() * sizeof(Reference) +
+           deferred_.capacity() * sizeof(Deferred) + deferredFrames_.capacity() * sizeof(double);
 }
 
 std::vector<std::vector<uint32_t>> UnrolledInstance::bvhLeafGroups() const {
@@ -792,6 +811,13 @@ uint64_t UnrolledInstance::digest() const {
         }
     d.add(links_.size());
     for (const Link& l : links_) d.add(l.parent), d.add(l.matrix);
+    // (only where there are some: the digests of other expansions stay what they were)
+    if (!deferred_.empty()) d.add(deferred_.size());
+    for (const Deferred& x : deferred_) {
+        for (uint32_t v : {x.select, x.depth, x.stateDepth, x.frame}) d.add(v);
+        for (uint64_t v : {x.path, x.key.a, x.key.b}) d.add(v);
+    }
+    if (!deferredFrames_.empty()) d.addAll(deferredFrames_);
     for (uint32_t v : {root_, rootBvh_, levels_, bvhLeaves_, linkSlots_}) d.add(v);
     return d.h;
 }
@@ -942,6 +968,9 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
             found = firstInInstance(instances_[node.first], rr, tmin, tmax, hit,
                                     Use{instances_[node.first].path, material, paint}, anyHit, s);
             break;
+        case Kind::Deferred:
+            found = firstInDeferred(node, rr, tmin, tmax, hit, material, s);
+            break;
         case Kind::Operator:
             if (node.op != CsgOp::Union) {
                 std::vector<Span>& buffer = s.spans;
@@ -980,6 +1009,16 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
         return x.firstBvh(x.rootBvh_, r, tmin, tmax, hit, inside, anyHit, s);
     }
     return x.root_ != kNone && x.firstAt(x.root_, r, tmin, tmax, hit, inside, anyHit, s);
+}
+
+// A Deferred node's instance, the ray in its S-node's frame: the walker's (the tracer's).
+// (Out of line, as firstInInstance.)
+[[gnu::noinline]] bool UnrolledInstance::firstInDeferred(const Node& node, const LocalRay& r,
+                                                         double tmin, double& tmax, Hit& hit,
+                                                         uint32_t material, Scratch& s) const {
+    const Deferred& d = deferred_[node.first];
+    return s.walker->firstDeferred(d, deferredFrames_.data() + d.frame, r, tmin, tmax, hit,
+                                   material);
 }
 
 // The first hit among the nodes list[0..count), all entered from the same frame, as the
@@ -1095,6 +1134,8 @@ size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
     switch (node.kind) {
         case Kind::Triangle:
             return 0;  // surfaces: never under ∩ or \ (the compiler checks)
+        case Kind::Deferred:
+            return 0;  // (top levels only, which hold unions and are traced by first())
         case Kind::Solid: {
             SpanRoom room;
             Span* sp = room.s;

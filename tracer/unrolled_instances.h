@@ -34,7 +34,8 @@
 //    kind Instance: the S-node's matrices and material as for a primitive, and its
 //    instance path, computed once, since the top level is traced from the root only; the
 //    instance referred to replays its hits' paths from that path), so that the copies of
-//    one instance share its arrays.
+//    one instance share its arrays; or at S-node instances it leaves to the tracer (a
+//    node of kind Deferred, with the S-node's parameters and path: Walker).
 #pragma once
 
 #include <cstdint>
@@ -55,8 +56,9 @@ class UnrolledInstance {
     static constexpr uint32_t kInherit = UINT32_MAX;  // material: the caller's
 
     // Instance: another expanded instance (instances_[first]), entered at its S-node
-    // (expandTop's only).
-    enum class Kind : uint8_t { Solid, Triangle, Operator, Instance };
+    // (expandTop's only). Deferred: an S-node instance not expanded here (deferred_[first]),
+    // which the tracer tracing the top level walks or finds expanded (expandTop's only).
+    enum class Kind : uint8_t { Solid, Triangle, Operator, Instance, Deferred };
 
     struct Node {
         Kind kind;
@@ -105,9 +107,32 @@ class UnrolledInstance {
         uint32_t parent, matrix;
     };
 
+    // A Deferred node's S-node instance: the S-node, its depth (Semantics::selectDepth) and
+    // the walk's state there (the parameters at deferredFrames_[frame..], the instance path,
+    // the S-nodes passed), and its instance key.
+    struct Deferred {
+        NodeId select;
+        uint32_t depth, stateDepth;
+        uint32_t frame;
+        uint64_t path;
+        InstanceBoxes::Key key;
+    };
+    // What traces a Deferred node's instance: the tracer whose scratch space this is (it
+    // finds the instance expanded in its cache, or walks the graph below the S-node). The
+    // ray is in the S-node's frame; the hit's normal comes back in that frame.
+    class Walker {
+      public:
+        virtual bool firstDeferred(const Deferred& d, const double* frame, const LocalRay& r,
+                                   double tmin, double& tmax, Hit& hit, uint32_t material) = 0;
+
+      protected:
+        ~Walker() = default;
+    };
+
     // Scratch space of one thread (stacks of the walk; the ray of each link, valid in the
-    // walk of one BVH, the one with its stamp).
+    // walk of one BVH, the one with its stamp; the walker of Deferred nodes).
     struct Scratch {
+        Walker* walker = nullptr;
         std::vector<std::pair<double, uint32_t>> order;
         std::vector<Span> spans;
         struct Linked {
@@ -137,13 +162,18 @@ class UnrolledInstance {
 
     // Where an expansion of the whole graph (expandTop) stops: the expanded instance to
     // refer to for the S-node `select` entered in state `s` at `depth` (it must outlive the
-    // expansion), nullptr to expand the S-node in place; throws Refused to give up. And the
-    // node visits the expansion may take, asked again each time it passes them (so that
-    // the cuts met so far may raise them).
+    // expansion), nullptr to expand the S-node in place; throws Refused to give up. Where
+    // it gives none, `defer` may stop there with a Deferred node (true: its box in the
+    // S-node's frame and its key in `box` and `key`). And the node visits the expansion may
+    // take, asked again each time it passes them (so that the cuts met so far may raise
+    // them).
     struct Refused {};
     class Cuts {
       public:
         virtual const UnrolledInstance* cut(NodeId select, const PathState& s, uint32_t depth) = 0;
+        virtual bool defer(NodeId, const PathState&, uint32_t, Box&, InstanceBoxes::Key&) {
+            return false;
+        }
         virtual uint64_t maxVisits() const = 0;
 
       protected:
@@ -159,6 +189,7 @@ class UnrolledInstance {
     static size_t keptBuildBytes();
 
     const Box& box() const { return nodes_[root_].box; }
+    size_t deferredNodes() const { return deferred_.size(); }
     bool empty() const { return root_ == kNone; }
     // S-nodes nested below the instance's own (the expansion is used only where the
     // deepest of them stays within max_depth).
@@ -183,6 +214,8 @@ class UnrolledInstance {
     bool firstAt(uint32_t n, const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
                  bool anyHit, Scratch& s) const;
     struct Reference;
+    bool firstInDeferred(const Node& node, const LocalRay& r, double tmin, double& tmax, Hit& hit,
+                         uint32_t material, Scratch& s) const;
     bool firstInInstance(const Reference& ref, const LocalRay& r, double tmin, double& tmax,
                          Hit& hit, const Use& inside, bool anyHit, Scratch& s) const;
     size_t spansAt(uint32_t n, const LocalRay& r, double tmin, double tmax,
@@ -214,6 +247,10 @@ class UnrolledInstance {
         uint64_t path;
     };
     std::vector<Reference> instances_;
+    // Deferred nodes: their S-node instances, and the parameters of each (slotCount() a
+    // node).
+    std::vector<Deferred> deferred_;
+    std::vector<double> deferredFrames_;
     uint32_t linkSlots_ = 0;  // Scratch::linked entries needed, instances referred to included
     uint32_t root_ = kNone;
     // The root's first-hit hierarchy when firstAt(root_) would do nothing but walk it (a
