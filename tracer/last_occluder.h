@@ -37,6 +37,9 @@ class LastOccluder {
     // ray (within the caller's UnrollCache::Pin scope).
     bool occludes(UnrollCache::Reader& cache, uint32_t maxDepth, const LocalRay& r, double tmin,
                   double tmax);
+    // Starts a ray that does not try the copy (one through the top level): missed() is
+    // false for it, whatever the last ray that tried the copy found.
+    void untried() { tried_ = false; }
     // The copy being entered (at `path`, after entering()) is the one occludes() tried for
     // this ray and found nothing in.
     bool missed(uint64_t path) const {

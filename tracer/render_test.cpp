@@ -10,7 +10,9 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <span>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -501,6 +503,30 @@ TEST(Render, TooDeepRecursionIsTheMaxDepthError) {
             << "culling " << useBounds << ": " << e.message;
         EXPECT_EQ(e.modulePath.size(), static_cast<size_t>(allowed) + 1) << "culling " << useBounds;
     }
+}
+
+// The terrain (scenes/terrain.pcsg at order 8) on one thread, with adaptive supersampling:
+// the same image with the expanded instances and the top level of deferred cuts as with the
+// walk alone. (The walk's last occluder, tried in vain by the last shadow ray before the top
+// level, once made a walk below a deferred node skip that copy: 508 pixels lit in shadow.)
+TEST(Render, TheTerrainsTopLevelOfDeferredCutsChangesNoPixel) {
+    std::ifstream in(std::string(PCSG_SCENES_DIR) + "/terrain.pcsg");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    const size_t at = s.find("cnt = 10;");
+    ASSERT_NE(at, std::string::npos);
+    auto c = compile(s.replace(at, 9, "cnt = 8;"));
+    ASSERT_TRUE(c->graph);
+    RenderOptions o = small(1);
+    o.width = 320;  // (at 160 x 120 a skipped occluder was not met)
+    o.height = 240;
+    o.adaptive = 0.3;
+    const RenderResult expanded = render(*c->graph, o);
+    o.expansionBytes = 0;
+    const RenderResult walked = render(*c->graph, o);
+    EXPECT_TRUE(sameBytes(expanded, walked))
+        << differingPixels(expanded, walked) << " pixels differ without the expansions";
 }
 
 }  // namespace

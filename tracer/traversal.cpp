@@ -311,6 +311,7 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     paintMaps_.clear();
     inverses_.clear();
     if (const TopLevel* top = topLevel()) {
+        occluder_.untried();  // (the walk below its deferred nodes asks missed())
         if (!top->first(r, tmin, best, hit, anyHit_, expansion_->scratch())) return false;
     } else {
         if (anyHit_ && expansion_ &&
