@@ -153,7 +153,9 @@ Result compareRays(const std::string& text, const std::vector<Vec3>& o, const st
         EXPECT_EQ(ha.path, hb.path) << "ray " << i;
         EXPECT_EQ(ha.material, hb.material) << "ray " << i;
         EXPECT_EQ(ha.painted, hb.painted) << "ray " << i;
-        if (ha.painted) EXPECT_EQ(ha.paintPoint, hb.paintPoint) << "ray " << i;
+        if (ha.painted) {
+            EXPECT_EQ(ha.paintPoint, hb.paintPoint) << "ray " << i;
+        }
     }
     out.expansionsAfter = b.expansions() - expansionsBefore;
     return out;
