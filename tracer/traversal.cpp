@@ -293,16 +293,10 @@ void Tracer::checkStackLimit(uintptr_t here) {
         g_.scene.settings.maxDepth));
 }
 
-bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
-    if (g_.axiom == kNone) return false;
-    const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
-    const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
-    const LocalRay r{origin, dir};
-    Hit hit;
-    double best = tmax;
-    // The graph walk's own stacks (also below a top level's Deferred nodes; the top level's
-    // walk keeps its state in the expansions' scratch, and its hits have no paint frame of
-    // the graph walk's).
+// The graph walk's own stacks, for a walk from the root or below a top level's Deferred
+// nodes (a walk that threw leaves them as they were; the top level's own walk keeps its
+// state in the expansions' scratch, and its hits have no paint frame of the graph walk's).
+void Tracer::resetWalk() {
     frames_.reset();
     spans_.clear();
     order_.clear();
@@ -310,10 +304,23 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     paintInteriors_.clear();
     paintMaps_.clear();
     inverses_.clear();
+}
+
+bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
+    if (g_.axiom == kNone) return false;
+    const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
+    const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
+    const LocalRay r{origin, dir};
+    Hit hit;
+    double best = tmax;
     if (const TopLevel* top = topLevel()) {
-        occluder_.untried();  // (the walk below its deferred nodes asks missed())
+        if (top->deferred() > 0) {  // (the walk below them, which asks missed())
+            resetWalk();
+            occluder_.untried();
+        }
         if (!top->first(r, tmin, best, hit, anyHit_, expansion_->scratch())) return false;
     } else {
+        resetWalk();
         if (anyHit_ && expansion_ &&
             occluder_.occludes(*expansion_, g_.scene.settings.maxDepth, r, tmin, tmax))
             return true;

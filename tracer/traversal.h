@@ -270,6 +270,7 @@ class Tracer final : private UnrolledInstance::Walker {
     auto unary(NodeId n, const LocalRay& r, const Ctx& c, double tmin, double tmax, Below below,
                Unrolled unrolled, TransformBack transformBack);
     bool walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& hit);
+    void resetWalk();
     bool firstDeferred(const UnrolledInstance::Deferred& d, const double* frame, const LocalRay& r,
                        double tmin, double& tmax, Hit& hit, uint32_t material) override;
     const TopLevel* topLevel();
