@@ -577,6 +577,10 @@ RenderResult RegionRenderer::figures() const {
         }
     if (s.scene.instanceBoxes()) r.instanceBoxes = s.scene.instanceBoxes()->stats();
     r.expansionBudget = s.scene.expansionBudget();
+    if (const TopLevel* t = s.scene.topLevel()) {
+        const size_t deferred = t->deferred();
+        r.topLevel = {true, deferred > 0 ? 0 : t->copies(), t->instances(), deferred, t->bytes()};
+    }
     return r;
 }
 

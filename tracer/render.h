@@ -111,6 +111,12 @@ struct RenderResult {
     InstanceBoxStats instanceBoxes;  // the instance-box cache at the end
     uint64_t expansions = 0;         // sub-graph instances expanded (all threads)
     size_t expansionBudget = 0;      // the bytes the expansion cache's budget grew to
+    // The two-level structure (top_level.h), if it was built: its copies of shared
+    // instances and those instances, or its cuts deferred to the walk, and its bytes.
+    struct TopLevelFigures {
+        bool built = false;
+        size_t copies = 0, instances = 0, deferred = 0, bytes = 0;
+    } topLevel;
 };
 
 // Renders the scene's graph. Throws RuntimeError (the first run-time error of the scene)

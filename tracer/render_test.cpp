@@ -527,6 +527,12 @@ TEST(Render, TheTerrainsTopLevelOfDeferredCutsChangesNoPixel) {
     const RenderResult walked = render(*c->graph, o);
     EXPECT_TRUE(sameBytes(expanded, walked))
         << differingPixels(expanded, walked) << " pixels differ without the expansions";
+    // (and the render reports its top level: the patches' cuts, none without expansions)
+    EXPECT_TRUE(expanded.topLevel.built);
+    EXPECT_GE(expanded.topLevel.deferred, 8u);
+    EXPECT_EQ(expanded.topLevel.copies, 0u);
+    EXPECT_GT(expanded.topLevel.bytes, 0u);
+    EXPECT_FALSE(walked.topLevel.built);
 }
 
 }  // namespace

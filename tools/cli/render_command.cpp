@@ -366,6 +366,12 @@ void printJson(const RenderCommandOptions& o, const RenderReport& report) {
                            {"full", result.instanceBoxes.full}};
     j["expanded_instances"] = result.expansions;
     j["expansion_budget_bytes"] = result.expansionBudget;  // reached (at most the maximum)
+    const tracer::RenderResult::TopLevelFigures& top = result.topLevel;
+    j["top_level"] = {{"built", top.built},
+                      {"copies", top.copies},
+                      {"instances", top.instances},
+                      {"deferred_cuts", top.deferred},
+                      {"bytes", top.bytes}};
     j["aa"] = o.aa;
     j["adaptive"] = o.adaptive;
     j["graph_nodes"] = report.graphNodes;
@@ -684,6 +690,13 @@ void printText(const RenderCommandOptions& o, const RenderReport& report) {
         std::cout << fmt::format(
             "{:<24}{} instances, {}{}\n", "instance-box cache", result.instanceBoxes.entries,
             humanBytes(result.instanceBoxes.bytes), result.instanceBoxes.full ? " (full)" : "");
+    if (const tracer::RenderResult::TopLevelFigures& top = result.topLevel; top.built)
+        std::cout << fmt::format("{:<24}{}, {}\n", "top level",
+                                 top.deferred > 0
+                                     ? fmt::format("{} cuts deferred to the walk", top.deferred)
+                                     : fmt::format("{} copies of {} instance{}", top.copies,
+                                                   top.instances, top.instances == 1 ? "" : "s"),
+                                 humanBytes(top.bytes));
     if (report.helper)
         std::cout << fmt::format("{:<24}{} ({}, {:.3f} s after the render)\n",
                                  "image writer peak RSS", humanBytes(report.helper->peakRssBytes),

@@ -16,7 +16,9 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -144,6 +146,40 @@ TEST(RenderCommand, WritesAPngOfTheRightSize) {
     EXPECT_FALSE(j.contains("image_writer_seconds"));
     EXPECT_EQ(filesIn(dir.path()), (std::vector<std::string>{"s.pcsg", "s.png"}));
     EXPECT_EQ(subreaper.leftovers(), 0);
+}
+
+// The figures name the top level the render built: Sierpinski order 8's copies of one shared
+// instance, and the terrain's cuts deferred to the walk (its instances are all unique), in
+// the JSON and in the lines for people.
+TEST(RenderCommand, TheFiguresNameTheTopLevel) {
+    TempDir dir;
+    std::ifstream in(std::string(PCSG_SOURCE_DIR) + "/scenes/terrain.pcsg");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string terrain = text.str();
+    const size_t at = terrain.find("cnt = 10;");
+    ASSERT_NE(at, std::string::npos);
+    const std::string scenes[] = {std::string(PCSG_SOURCE_DIR) + "/tools/bench/sierpinski_8.pcsg",
+                                  dir.write("t6.pcsg", terrain.replace(at, 9, "cnt = 6;"))};
+    for (const std::string& scene : scenes) {
+        const std::vector<std::string> args = {"render",     scene, "-o",       dir.file("x.png"),
+                                               "--width",    "64",  "--height", "48",
+                                               "--adaptive", "0.3"};
+        std::vector<std::string> json = args;
+        json.push_back("--json");
+        const ChildResult r = pcsg(json), people = pcsg(args);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        ASSERT_EQ(people.exitCode, 0) << people.err;
+        const auto top = nlohmann::json::parse(r.out).at("top_level");
+        EXPECT_TRUE(top.at("built").get<bool>()) << scene;
+        EXPECT_GT(top.at("bytes").get<uint64_t>(), 0u) << scene;
+        const bool deferred = scene == scenes[1];
+        EXPECT_EQ(top.at("deferred_cuts").get<uint64_t>() > 0, deferred) << scene;
+        EXPECT_EQ(top.at("copies").get<uint64_t>() > 0, !deferred) << scene;
+        EXPECT_EQ(top.at("instances").get<uint64_t>(), deferred ? 0u : 1u) << scene;
+        const std::string line = deferred ? "cuts deferred to the walk" : "copies of 1 instance,";
+        EXPECT_NE(people.out.find(line), std::string::npos) << people.out;
+    }
 }
 
 // A still PNG's rows go into the file as the render finishes them, and the figures say so.
