@@ -10,9 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <span>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -510,13 +508,9 @@ TEST(Render, TooDeepRecursionIsTheMaxDepthError) {
 // walk alone. (The walk's last occluder, tried in vain by the last shadow ray before the top
 // level, once made a walk below a deferred node skip that copy: 508 pixels lit in shadow.)
 TEST(Render, TheTerrainsTopLevelOfDeferredCutsChangesNoPixel) {
-    std::ifstream in(std::string(PCSG_SCENES_DIR) + "/terrain.pcsg");
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string s = text.str();
-    const size_t at = s.find("cnt = 10;");
-    ASSERT_NE(at, std::string::npos);
-    auto c = compile(s.replace(at, 9, "cnt = 8;"));
+    const std::string text = testing::terrain(8);
+    ASSERT_FALSE(text.empty());
+    auto c = compile(text);
     ASSERT_TRUE(c->graph);
     RenderOptions o = small(1);
     o.width = 320;  // (at 160 x 120 a skipped occluder was not met)

@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -200,6 +202,18 @@ S if(c > 0, 2, 1)
 }
 inline const std::string kSierpinskiText = sierpinski(4);
 inline const char* const kSierpinski = kSierpinskiText.c_str();  // (order 4)
+
+// The scene file scenes/terrain.pcsg at order `order` (its cnt) instead of 10 ("" when the
+// file or its cnt is not found).
+inline std::string terrain(int order) {
+    std::ifstream in(std::string(PCSG_SCENES_DIR) + "/terrain.pcsg");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    const size_t at = s.find("cnt = 10;");
+    if (at == std::string::npos) return "";
+    return s.replace(at, 9, "cnt = " + std::to_string(order) + ";");
+}
 
 // A flower head of p petals: 21 petals as a chain of unions 21 deep, each a rotation
 // further on; each value of p is an instance of its own.

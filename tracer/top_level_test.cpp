@@ -8,9 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <random>
-#include <sstream>
 
 #include "bounds.h"
 #include "test_support.h"
@@ -21,6 +19,7 @@ namespace {
 
 using testing::compile;
 using testing::eagerExpansion;
+using testing::terrain;
 
 // Flower heads (test_support.h's kFlower): painted petals, an unpainted centre that takes
 // the material of each copy's paint node, copies under rotations and a shear.
@@ -89,17 +88,6 @@ T if(n > 0, 2, 1)
 1: T -> paint(bumpy) move(0,0,h*0.01) scale(1.5, 20, 20) sphere
 2: T -> {n = n-1; h = 2*h} move(1,0,0) uscale(0.5) T ∪ {n = n-1; h = 2*h+1} move(-1,0,0) uscale(0.5) T
 )";
-
-// The scene file scenes/terrain.pcsg at order `order` (its cnt) instead of 10.
-std::string terrain(int order) {
-    std::ifstream in(std::string(PCSG_SCENES_DIR) + "/terrain.pcsg");
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string s = text.str();
-    const size_t at = s.find("cnt = 10;");
-    if (at == std::string::npos) return "";
-    return s.replace(at, 9, "cnt = " + std::to_string(order) + ";");
-}
 
 struct Result {
     size_t copies = 0, instances = 0, deferred = 0, hits = 0;
