@@ -39,7 +39,10 @@
 //    of the walk of every level above it (the terrain: 50 M node visits at 640x480 became
 //    7 M). Refused where a paint node's material needs its frame (the walk below a
 //    deferred node does not have the matrices above it), where the cache expands nowhere,
-//    or past maxBytes / kBytesPerDeferredVisit node visits or `maxBytes`.
+//    or past maxBytes / kBytesPerDeferredVisit node visits or `maxBytes`. A run-time error
+//    below a cut refuses it too: the exact box of the cut's instance unrolls all of it and
+//    meets the error (so a walk below a deferred node never raises one without the
+//    modules above its cut in its path).
 //  - When it is built: by TraceScene::buildTopLevel, which a tracer calls once the
 //    expansion cache has seen a few thousand rays enter the scene (so that the cuts are
 //    known); per TraceScene, so per frame of a sequence. Immutable once built.
