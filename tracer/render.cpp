@@ -577,10 +577,8 @@ RenderResult RegionRenderer::figures() const {
         }
     if (s.scene.instanceBoxes()) r.instanceBoxes = s.scene.instanceBoxes()->stats();
     r.expansionBudget = s.scene.expansionBudget();
-    if (const TopLevel* t = s.scene.topLevel()) {
-        const size_t deferred = t->deferred();
-        r.topLevel = {true, deferred > 0 ? 0 : t->copies(), t->instances(), deferred, t->bytes()};
-    }
+    if (const TopLevel* t = s.scene.topLevel())
+        r.topLevel = {true, t->copies(), t->instances(), t->deferred(), t->bytes()};
     return r;
 }
 

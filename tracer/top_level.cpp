@@ -174,7 +174,6 @@ std::unique_ptr<TopLevel> TopLevel::buildDeferred(const TraceScene& scene, const
     t->top_ = UnrolledInstance::expandTop(scene, cuts);
     if (!t->top_ || t->top_->empty() || t->top_->deferredNodes() == 0) return nullptr;
     t->bytes_ = t->top_->bytes();
-    t->copies_ = t->top_->deferredNodes();
     if (t->bytes_ > maxBytes) return nullptr;
     return t;
 }

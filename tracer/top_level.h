@@ -88,8 +88,8 @@ class TopLevel {
         return top_->first(r, tmin, tmax, hit, {kRootPath, 0, 0}, anyHit, s);
     }
 
-    size_t bytes() const { return bytes_; }  // the top level and the instances it holds
-    size_t copies() const { return copies_; }
+    size_t bytes() const { return bytes_; }    // the top level and the instances it holds
+    size_t copies() const { return copies_; }  // of shared instances (none: deferred cuts)
     size_t instances() const { return owned_.size(); }
     // Instances it holds that the expansion cache had built (and shares with it).
     size_t sharedInstances() const { return shared_; }

@@ -16,15 +16,14 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli_test_util.h"
 #include "image_format.h"
 #include "image_test_util.h"
+#include "test_support.h"
 
 namespace pcsg::tools {
 namespace {
@@ -153,14 +152,10 @@ TEST(RenderCommand, WritesAPngOfTheRightSize) {
 // the JSON and in the lines for people.
 TEST(RenderCommand, TheFiguresNameTheTopLevel) {
     TempDir dir;
-    std::ifstream in(std::string(PCSG_SOURCE_DIR) + "/scenes/terrain.pcsg");
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string terrain = text.str();
-    const size_t at = terrain.find("cnt = 10;");
-    ASSERT_NE(at, std::string::npos);
+    const std::string terrain = tracer::testing::terrain(6);
+    ASSERT_FALSE(terrain.empty());
     const std::string scenes[] = {std::string(PCSG_SOURCE_DIR) + "/tools/bench/sierpinski_8.pcsg",
-                                  dir.write("t6.pcsg", terrain.replace(at, 9, "cnt = 6;"))};
+                                  dir.write("t6.pcsg", terrain)};
     for (const std::string& scene : scenes) {
         const std::vector<std::string> args = {"render",     scene, "-o",       dir.file("x.png"),
                                                "--width",    "64",  "--height", "48",
