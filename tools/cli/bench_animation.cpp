@@ -82,4 +82,32 @@ AnimationRow benchAnimation(const AnimationBenchOptions& o, const fs::path& work
     return row;
 }
 
+AnimationRow medianAnimation(const std::vector<AnimationRow>& repetitions) {
+    for (const AnimationRow& r : repetitions)
+        if (!r.nativeOk) return r;
+    const auto of = [&repetitions](auto AnimationRow::*field) {
+        std::vector<double> v;
+        for (const AnimationRow& r : repetitions) v.push_back(double(r.*field));
+        return median(std::move(v));
+    };
+    AnimationRow out = repetitions.front();
+    out.nativeSeconds = of(&AnimationRow::nativeSeconds);
+    out.nativeRss = static_cast<uint64_t>(of(&AnimationRow::nativeRss));
+    for (const AnimationRow& r : repetitions)
+        if (!r.povOk) {
+            out.povOk = false;
+            out.note = r.note;
+            break;
+        }
+    if (out.povOk) {
+        out.exportSeconds = of(&AnimationRow::exportSeconds);
+        out.povraySeconds = of(&AnimationRow::povraySeconds);
+        out.povRss = static_cast<uint64_t>(of(&AnimationRow::povRss));
+    }
+    out.runs.clear();
+    for (const AnimationRow& r : repetitions)
+        out.runs.push_back({r.nativeSeconds, r.povSeconds(), r.nativeRss, r.povRss, r.povOk});
+    return out;
+}
+
 }  // namespace pcsg::tools

@@ -8,6 +8,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
+
+#include "bench_median.h"
 
 namespace pcsg::tools {
 
@@ -31,9 +34,14 @@ struct AnimationRow {
     double povraySeconds = 0;  // the whole `povray OUT.ini` command
     uint64_t povRss = 0;       // its peak RSS
     double povSeconds() const { return exportSeconds + povraySeconds; }
+    std::vector<SideBySideRun> runs;  // each repetition (medianAnimation: more than one)
 };
 
 // Renders both ways in `work` (removing the frames afterwards).
 AnimationRow benchAnimation(const AnimationBenchOptions& o, const std::filesystem::path& work);
+
+// The row of N repetitions (bench_median.h): the first failed one as it is, else each
+// figure the median of the repetitions', and `runs` each repetition's.
+AnimationRow medianAnimation(const std::vector<AnimationRow>& repetitions);
 
 }  // namespace pcsg::tools

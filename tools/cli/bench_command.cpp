@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "bench_animation.h"
+#include "bench_median.h"
 #include "bench_plot.h"
 #include "commands.h"
 #include "embree_run.h"
@@ -40,6 +41,7 @@ struct BenchOptions {
     int threads = 0;
     bool json = false;
     bool nativeOnly = false;
+    int repeat = 1;        // each row measured this many times, its figures the medians
     std::string markdown;  // append the table to this file
     uint64_t maxNodes = 10'000'000;
     // The animation row: frames of animationScene (0: none). By default 48 with the
@@ -48,20 +50,6 @@ struct BenchOptions {
     std::string plot;  // --plot FILE: the scaling sweep instead of the table
     std::vector<int> plotOrders = {4, 16};
     std::string animationScene = std::string(PCSG_SOURCE_DIR) + "/scenes/growing_tree.pcsg";
-};
-
-struct BenchRow {
-    std::string scene;
-    bool nativeOk = false, povOk = false;
-    std::string note;
-    double nativeSeconds = 0, povSeconds = 0;
-    std::optional<double> povParseSeconds;
-    // Of the whole render commands, as /usr/bin/time -v counts them (wait4's rusage).
-    uint64_t nativeRss = 0, povRss = 0;
-    std::optional<double> raysPerSecond;
-    std::optional<uint64_t> primitives;
-    double nativeCommandSeconds = 0;  // the whole `pcsg render` command's wall time
-    std::optional<EmbreeRun> embree;  // a triangle-only scene that pcsg-embree traced
 };
 
 // The scenes of the targets: the Sierpinski tetrahedron at growing order and the
@@ -224,17 +212,18 @@ std::vector<Target> targetsOf(const std::vector<BenchRow>& rows) {
                      r->nativeRss <= kOrder8RssLimit});
         if (r->povOk) {
             const double time = r->povSeconds / std::max(r->nativeSeconds, 1e-9);
-            t.push_back({fmt::format("order 8 at least 5x faster than POV-Ray ({:.2f}x)", time),
+            t.push_back({fmt::format("order 8 at least 5x faster than POV-Ray ({:.2f}x{})", time,
+                                     runsText(timeRatios(r->runs))),
                          time >= 5});
-            t.push_back(
-                {fmt::format("order 8 peak RSS at most 1/20 of POV-Ray's (1/{:.1f})", rssRatio(*r)),
-                 rssRatio(*r) >= 20});
+            t.push_back({fmt::format("order 8 peak RSS at most 1/20 of POV-Ray's (1/{:.1f}{})",
+                                     rssRatio(*r), runsText(rssRatios(r->runs), 1)),
+                         rssRatio(*r) >= 20});
         }
     }
     if (const BenchRow* r = find("sierpinski_9"); r && r->povOk)
-        t.push_back(
-            {fmt::format("order 9 peak RSS at most 1/20 of POV-Ray's (1/{:.1f})", rssRatio(*r)),
-             rssRatio(*r) >= 20});
+        t.push_back({fmt::format("order 9 peak RSS at most 1/20 of POV-Ray's (1/{:.1f}{})",
+                                 rssRatio(*r), runsText(rssRatios(r->runs), 1)),
+                     rssRatio(*r) >= 20});
     const BenchRow *o10 = find("sierpinski_10"), *o12 = find("sierpinski_12");
     if (o12) {
         if (o10 && o10->povOk)
@@ -249,9 +238,9 @@ std::vector<Target> targetsOf(const std::vector<BenchRow>& rows) {
     for (const auto& [name, factor] : {std::pair{"sympodial_tree", 5.0}, {"terrain", 10.0}})
         if (const BenchRow* r = find(name); r && r->povOk) {
             const double time = r->povSeconds / std::max(r->nativeSeconds, 1e-9);
-            t.push_back(
-                {fmt::format("{} at least {:g}x faster than POV-Ray ({:.2f}x)", name, factor, time),
-                 time >= factor});
+            t.push_back({fmt::format("{} at least {:g}x faster than POV-Ray ({:.2f}x{})", name,
+                                     factor, time, runsText(timeRatios(r->runs))),
+                         time >= factor});
         }
     if (const BenchRow* r = find("terrain"))
         t.push_back({fmt::format("terrain whole render command at most 64.0 MB peak RSS ({})",
@@ -259,12 +248,14 @@ std::vector<Target> targetsOf(const std::vector<BenchRow>& rows) {
                      r->nativeRss <= (64ull << 20)});
     // The textured scene of issue 11: picture 9's island in a bump-mapped, Fresnel sea.
     if (const BenchRow* r = find("terrain_sea"); r && r->povOk) {
-        t.push_back({fmt::format("terrain_sea (textured) faster than POV-Ray ({:.2f}x)",
-                                 r->povSeconds / std::max(r->nativeSeconds, 1e-9)),
+        t.push_back({fmt::format("terrain_sea (textured) faster than POV-Ray ({:.2f}x{})",
+                                 r->povSeconds / std::max(r->nativeSeconds, 1e-9),
+                                 runsText(timeRatios(r->runs))),
                      r->nativeSeconds < r->povSeconds});
-        t.push_back({fmt::format("terrain_sea (textured) in less peak RSS than POV-Ray (1/{:.1f})",
-                                 rssRatio(*r)),
-                     r->nativeRss < r->povRss});
+        t.push_back(
+            {fmt::format("terrain_sea (textured) in less peak RSS than POV-Ray (1/{:.1f}{})",
+                         rssRatio(*r), runsText(rssRatios(r->runs), 1)),
+             r->nativeRss < r->povRss});
     }
     addEmbreeTargets(rows, t);
     return t;
@@ -277,17 +268,29 @@ std::string targetsText(const std::vector<Target>& targets) {
     return t.empty() ? t : "\nTargets:\n" + t;
 }
 
+// Each repetition's times and peaks (--repeat), POV-Ray's where it rendered.
+nlohmann::json runsJson(const std::vector<SideBySideRun>& runs) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const SideBySideRun& r : runs) {
+        nlohmann::json e = {{"native_seconds", r.nativeSeconds},
+                            {"native_peak_rss_bytes", r.nativeRss}};
+        if (r.povOk) e["povray_seconds"] = r.povSeconds, e["povray_peak_rss_bytes"] = r.povRss;
+        j.push_back(e);
+    }
+    return j;
+}
+
 // The animation targets: at least 3x less total time than POV-Ray on the exported frames,
 // and at most 1/10 of its peak RSS.
 std::vector<Target> animationTargets(const std::optional<AnimationRow>& a) {
     if (!a || !a->nativeOk || !a->povOk) return {};
     const double time = a->povSeconds() / std::max(a->nativeSeconds, 1e-9);
     const double rss = double(a->povRss) / double(std::max<uint64_t>(a->nativeRss, 1));
-    return {{fmt::format("{} frames of {} in at least 3x less time than POV-Ray ({:.2f}x)",
-                         a->frames, a->scene, time),
+    return {{fmt::format("{} frames of {} in at least 3x less time than POV-Ray ({:.2f}x{})",
+                         a->frames, a->scene, time, runsText(timeRatios(a->runs))),
              time >= 3},
-            {fmt::format("{} frames of {} at most 1/10 of POV-Ray's peak RSS (1/{:.1f})", a->frames,
-                         a->scene, rss),
+            {fmt::format("{} frames of {} at most 1/10 of POV-Ray's peak RSS (1/{:.1f}{})",
+                         a->frames, a->scene, rss, runsText(rssRatios(a->runs), 1)),
              rss >= 10}};
 }
 
@@ -325,6 +328,7 @@ nlohmann::json animationJson(const AnimationRow& a) {
         j["povray_peak_rss_bytes"] = a.povRss;
     }
     if (!a.note.empty()) j["note"] = a.note;
+    if (!a.runs.empty()) j["runs"] = runsJson(a.runs);
     nlohmann::json targets = nlohmann::json::array();
     for (const Target& t : animationTargets(a))
         targets.push_back({{"target", t.what}, {"met", t.met}});
@@ -365,10 +369,15 @@ std::string tableOf(const std::vector<BenchRow>& rows, const BenchOptions& o) {
     const bool embree = std::any_of(rows.begin(), rows.end(),
                                     [](const BenchRow& r) { return r.embree.has_value(); });
     std::string t =
-        fmt::format("Benchmark of {}, {}: {}x{}, {} (both renderers), measured side by side.\n\n",
+        fmt::format("Benchmark of {}, {}: {}x{}, {} (both renderers), measured side by side{}.\n\n",
                     today(), machine(), o.width, o.height,
                     o.adaptive > 0 ? fmt::format("adaptive anti-aliasing {}", o.adaptive)
-                                   : std::string("no anti-aliasing"));
+                                   : std::string("no anti-aliasing"),
+                    o.repeat > 1 ? fmt::format("; each figure is the median of {} runs, one "
+                                               "after the other, and each verdict gives the "
+                                               "range of the runs' ratios",
+                                               o.repeat)
+                                 : "");
     t += "| scene | primitives | native time | POV-Ray time (parse) | POV-Ray / native | rays/s | "
          "native peak RSS | POV-Ray peak RSS | RSS ratio |";
     if (embree) t += " Embree build | Embree trace | Embree rays/s | Embree peak RSS |";
@@ -398,6 +407,7 @@ nlohmann::json jsonOf(const std::vector<BenchRow>& rows, const BenchOptions& o) 
         if (r.primitives) e["primitive_equivalence"] = *r.primitives;
         if (!r.note.empty()) e["note"] = r.note;
         if (r.nativeOk) e["native_command_seconds"] = r.nativeCommandSeconds;
+        if (!r.runs.empty()) e["runs"] = runsJson(r.runs);
         if (r.embree) {
             e["embree_triangles"] = r.embree->triangles;
             e["embree_build_seconds"] = r.embree->buildSeconds;
@@ -411,15 +421,19 @@ nlohmann::json jsonOf(const std::vector<BenchRow>& rows, const BenchOptions& o) 
     nlohmann::json targets = nlohmann::json::array();
     for (const Target& t : targetsOf(rows)) targets.push_back({{"target", t.what}, {"met", t.met}});
     return {{"date", today()},    {"machine", machine()},   {"width", o.width},
-            {"height", o.height}, {"adaptive", o.adaptive}, {"scenes", scenes},
-            {"targets", targets}};
+            {"height", o.height}, {"adaptive", o.adaptive}, {"repeat", o.repeat},
+            {"scenes", scenes},   {"targets", targets}};
+}
+
+// " (run 2 of 3)" with --repeat, for the progress lines; else "".
+std::string runOf(int k, const BenchOptions& o) {
+    return o.repeat > 1 ? fmt::format(" (run {} of {})", k + 1, o.repeat) : "";
 }
 
 // The animation row, when the options ask for one.
 std::optional<AnimationRow> animationRow(const BenchOptions& o, const fs::path& work) {
     const int frames = o.animationFrames.value_or(o.scenes.empty() ? 48 : 0);
     if (frames <= 0) return std::nullopt;
-    if (!o.json) std::cerr << "bench: " << frames << " frames of " << o.animationScene << " ...\n";
     AnimationBenchOptions a;
     a.scene = o.animationScene;
     a.frames = frames;
@@ -428,7 +442,15 @@ std::optional<AnimationRow> animationRow(const BenchOptions& o, const fs::path& 
     a.adaptive = o.adaptive;
     a.threads = o.threads;
     a.nativeOnly = o.nativeOnly;
-    return benchAnimation(a, work);
+    std::vector<AnimationRow> repetitions;
+    for (int k = 0; k < o.repeat; ++k) {
+        if (!o.json)
+            std::cerr << "bench: " << frames << " frames of " << o.animationScene << runOf(k, o)
+                      << " ...\n";
+        repetitions.push_back(benchAnimation(a, work));
+        if (!repetitions.back().nativeOk) break;
+    }
+    return o.repeat > 1 ? medianAnimation(repetitions) : repetitions.front();
 }
 
 int printBench(const std::vector<BenchRow>& rows, const std::optional<AnimationRow>& animation,
@@ -517,8 +539,13 @@ int runBench(BenchOptions o) {
     std::vector<BenchRow> rows;
     int status = 0;
     for (const auto& scene : o.scenes.empty() ? defaultScenes() : o.scenes) {
-        if (!o.json) std::cerr << "bench: " << scene << " ...\n";
-        rows.push_back(benchScene(scene, o, work, embree));
+        std::vector<BenchRow> repetitions;
+        for (int k = 0; k < o.repeat; ++k) {
+            if (!o.json) std::cerr << "bench: " << scene << runOf(k, o) << " ...\n";
+            repetitions.push_back(benchScene(scene, o, work, embree));
+            if (!repetitions.back().nativeOk) break;
+        }
+        rows.push_back(o.repeat > 1 ? medianRow(repetitions) : repetitions.front());
         if (!rows.back().nativeOk) status = 1;
     }
     const std::optional<AnimationRow> animation = animationRow(o, work);
@@ -562,6 +589,14 @@ void addBenchCommand(CLI::App& app, int& status) {
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     cmd->add_flag("--native-only", o->nativeOnly, "Render natively only (no POV-Ray, no Embree)");
+    auto* repeat =
+        cmd->add_option("--repeat", o->repeat,
+                        "Measure each row N times, one side-by-side run after the other, and "
+                        "report the median of each figure, with the range of the runs' ratios "
+                        "beside each verdict (a shared machine's timings vary by 20% from run to "
+                        "run)")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 100));
     cmd->add_option("--markdown", o->markdown,
                     "Append the table, with date and machine, to this file");
     cmd->add_option("--animation-frames", o->animationFrames,
@@ -581,6 +616,7 @@ void addBenchCommand(CLI::App& app, int& status) {
         ->expected(2)
         ->capture_default_str()
         ->check(CLI::Range(1, 20));
+    repeat->excludes("--plot");
     cmd->add_flag("--json", o->json, "Print the results as JSON");
     cmd->callback([o, &status] { status = runBench(*o); });
 }

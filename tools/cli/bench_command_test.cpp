@@ -1,6 +1,7 @@
 // pcsg bench: the table it prints and appends, its JSON, and its verdicts on the targets.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -38,6 +39,51 @@ TEST(BenchCommand, NativeOnlyJsonHasTheFiguresOfEachScene) {
     EXPECT_NE(j["targets"][0]["target"].get<std::string>().find("order 8 whole render command"),
               std::string::npos);
     EXPECT_TRUE(j["targets"][0]["met"].is_boolean());
+}
+
+TEST(BenchCommand, RepeatReportsTheMedianOfItsRuns) {
+    TempDir dir;
+    const std::string a = dir.write("sierpinski_8.pcsg", testing::kSierpinskiA);
+    const ChildResult r = pcsg({"bench", "--native-only", "--json", "--repeat", "3", "--width",
+                                "32", "--height", "24", a});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["repeat"], 3);
+    const auto& s = j["scenes"][0];
+    ASSERT_EQ(s["runs"].size(), 3u) << r.out;
+    std::vector<double> seconds;
+    std::vector<uint64_t> rss;
+    for (const auto& run : s["runs"]) {
+        seconds.push_back(run["native_seconds"].get<double>());
+        rss.push_back(run["native_peak_rss_bytes"].get<uint64_t>());
+        EXPECT_FALSE(run.contains("povray_seconds"));
+    }
+    std::sort(seconds.begin(), seconds.end());
+    std::sort(rss.begin(), rss.end());
+    EXPECT_EQ(s["native_seconds"].get<double>(), seconds[1]);
+    EXPECT_EQ(s["native_peak_rss_bytes"].get<uint64_t>(), rss[1]);
+    // Without --repeat: one run, no list of runs.
+    const ChildResult once =
+        pcsg({"bench", "--native-only", "--json", "--width", "32", "--height", "24", a});
+    ASSERT_EQ(once.exitCode, 0) << once.err;
+    const auto k = nlohmann::json::parse(once.out);
+    EXPECT_EQ(k["repeat"], 1);
+    EXPECT_FALSE(k["scenes"][0].contains("runs"));
+    // --repeat is for the table, not the plot.
+    EXPECT_NE(pcsg({"bench", "--repeat", "2", "--plot", dir.file("p.svg")}).exitCode, 0);
+}
+
+TEST(BenchCommand, RepeatedTableSaysSoAndGivesEachVerdictTheRunsRange) {
+    if (!inPath("povray")) GTEST_SKIP() << "povray is not installed";
+    TempDir dir;
+    const std::string a = dir.write("sierpinski_8.pcsg", testing::kSierpinskiA);
+    const ChildResult r = pcsg({"bench", "--repeat", "2", "--width", "48", "--height", "36", a});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("each figure is the median of 2 runs"), std::string::npos) << r.out;
+    const size_t verdict = r.out.find("order 8 at least 5x faster than POV-Ray (");
+    ASSERT_NE(verdict, std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("x; runs ", verdict), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find("(run 2 of 2)"), std::string::npos) << r.err;
 }
 
 TEST(BenchCommand, SideBySideTableWithDateMachineAndTargets) {
