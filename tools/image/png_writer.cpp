@@ -60,6 +60,12 @@ bool startPng(png_structp png, png_infop info, FILE* file, int width, int height
     // larger (docs/benchmarks.md, issue 14).
     png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
     png_set_compression_level(png, 1);
+    // zlib's hash table and output buffer at memory level 6 instead of 8: the encoder's
+    // state, alive for the whole render while rows stream in, takes 160 KB instead of 256 KB
+    // (its 32 KB window kept), for files within 1% of the size (the growing tree's 48
+    // frames 1.1% smaller, terrain_sea and landsberg 0.5% larger). The 48 frames' peak RSS
+    // is a target at 1/10 of POV-Ray's (docs/benchmarks.md).
+    png_set_compression_mem_level(png, 6);
     png_write_info(png, info);
     return true;
 }
