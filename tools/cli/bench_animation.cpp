@@ -86,9 +86,7 @@ AnimationRow medianAnimation(const std::vector<AnimationRow>& repetitions) {
     for (const AnimationRow& r : repetitions)
         if (!r.nativeOk) return r;
     const auto of = [&repetitions](auto AnimationRow::*field) {
-        std::vector<double> v;
-        for (const AnimationRow& r : repetitions) v.push_back(double(r.*field));
-        return median(std::move(v));
+        return medianOf(repetitions, [field](const AnimationRow& r) { return r.*field; });
     };
     AnimationRow out = repetitions.front();
     out.nativeSeconds = of(&AnimationRow::nativeSeconds);

@@ -23,14 +23,6 @@ double median(std::vector<double> values) {
 
 namespace {
 
-// The median of one figure over the rows.
-template <typename F>
-double medianOf(const std::vector<BenchRow>& rows, F&& figure) {
-    std::vector<double> v;
-    for (const BenchRow& r : rows) v.push_back(double(figure(r)));
-    return median(std::move(v));
-}
-
 uint64_t medianBytes(const std::vector<BenchRow>& rows, uint64_t BenchRow::*field) {
     return static_cast<uint64_t>(medianOf(rows, [field](const BenchRow& r) { return r.*field; }));
 }

@@ -46,6 +46,14 @@ struct BenchRow {
 // The median of the values (the mean of the middle two for an even count; 0 for none).
 double median(std::vector<double> values);
 
+// The median of one figure, figure(row), over rows of any kind (BenchRow, AnimationRow).
+template <typename Row, typename F>
+double medianOf(const std::vector<Row>& rows, F&& figure) {
+    std::vector<double> v;
+    for (const Row& r : rows) v.push_back(double(figure(r)));
+    return median(std::move(v));
+}
+
 // The row of N repetitions of one scene: the first failed repetition as it is (its native
 // render failed), else each figure the median of the repetitions', POV-Ray's only where every
 // repetition rendered it (else the first failure's note), Embree's only where every
