@@ -425,9 +425,22 @@ nlohmann::json jsonOf(const std::vector<BenchRow>& rows, const BenchOptions& o) 
             {"scenes", scenes},   {"targets", targets}};
 }
 
-// " (run 2 of 3)" with --repeat, for the progress lines; else "".
-std::string runOf(int k, const BenchOptions& o) {
-    return o.repeat > 1 ? fmt::format(" (run {} of {})", k + 1, o.repeat) : "";
+// A row measured o.repeat times (stopping at a failed native run), with a progress line
+// before each ("bench: WHAT (run 2 of 3) ..."): the one measurement, or the row combine()
+// makes of all of them (medianRow, medianAnimation).
+template <typename Measure, typename Combine>
+auto measureRepeated(const BenchOptions& o, const std::string& what, Measure&& measure,
+                     Combine&& combine) {
+    std::vector<decltype(measure())> repetitions;
+    for (int k = 0; k < o.repeat; ++k) {
+        if (!o.json)
+            std::cerr << "bench: " << what
+                      << (o.repeat > 1 ? fmt::format(" (run {} of {})", k + 1, o.repeat) : "")
+                      << " ...\n";
+        repetitions.push_back(measure());
+        if (!repetitions.back().nativeOk) break;
+    }
+    return o.repeat > 1 ? combine(repetitions) : repetitions.front();
 }
 
 // The animation row, when the options ask for one.
@@ -442,15 +455,9 @@ std::optional<AnimationRow> animationRow(const BenchOptions& o, const fs::path& 
     a.adaptive = o.adaptive;
     a.threads = o.threads;
     a.nativeOnly = o.nativeOnly;
-    std::vector<AnimationRow> repetitions;
-    for (int k = 0; k < o.repeat; ++k) {
-        if (!o.json)
-            std::cerr << "bench: " << frames << " frames of " << o.animationScene << runOf(k, o)
-                      << " ...\n";
-        repetitions.push_back(benchAnimation(a, work));
-        if (!repetitions.back().nativeOk) break;
-    }
-    return o.repeat > 1 ? medianAnimation(repetitions) : repetitions.front();
+    return measureRepeated(
+        o, fmt::format("{} frames of {}", frames, o.animationScene),
+        [&] { return benchAnimation(a, work); }, medianAnimation);
 }
 
 int printBench(const std::vector<BenchRow>& rows, const std::optional<AnimationRow>& animation,
@@ -539,13 +546,8 @@ int runBench(BenchOptions o) {
     std::vector<BenchRow> rows;
     int status = 0;
     for (const auto& scene : o.scenes.empty() ? defaultScenes() : o.scenes) {
-        std::vector<BenchRow> repetitions;
-        for (int k = 0; k < o.repeat; ++k) {
-            if (!o.json) std::cerr << "bench: " << scene << runOf(k, o) << " ...\n";
-            repetitions.push_back(benchScene(scene, o, work, embree));
-            if (!repetitions.back().nativeOk) break;
-        }
-        rows.push_back(o.repeat > 1 ? medianRow(repetitions) : repetitions.front());
+        rows.push_back(measureRepeated(
+            o, scene, [&] { return benchScene(scene, o, work, embree); }, medianRow));
         if (!rows.back().nativeOk) status = 1;
     }
     const std::optional<AnimationRow> animation = animationRow(o, work);
