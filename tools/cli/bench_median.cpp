@@ -44,6 +44,20 @@ std::optional<EmbreeRun> medianEmbree(const std::vector<BenchRow>& rows) {
     return e;
 }
 
+// pcsg-trace's figures, the median of each, when every repetition traced the scene.
+std::optional<NativeTraceRun> medianNativeTrace(const std::vector<BenchRow>& rows) {
+    for (const BenchRow& r : rows)
+        if (!r.nativeTrace) return std::nullopt;
+    NativeTraceRun n = *rows.front().nativeTrace;
+    const auto of = [&rows](double NativeTraceRun::*field) {
+        return medianOf(rows, [field](const BenchRow& r) { return (*r.nativeTrace).*field; });
+    };
+    n.buildSeconds = of(&NativeTraceRun::buildSeconds);
+    n.traceSeconds = of(&NativeTraceRun::traceSeconds);
+    n.raysPerSecond = of(&NativeTraceRun::raysPerSecond);
+    return n;
+}
+
 // POV-Ray's figures, the median of each, when every repetition rendered it.
 void medianPovray(const std::vector<BenchRow>& rows, BenchRow& out) {
     for (const BenchRow& r : rows)
@@ -75,6 +89,7 @@ BenchRow medianRow(const std::vector<BenchRow>& repetitions) {
             medianOf(repetitions, [](const BenchRow& r) { return r.raysPerSecond.value_or(0); });
     medianPovray(repetitions, out);
     out.embree = medianEmbree(repetitions);
+    out.nativeTrace = medianNativeTrace(repetitions);
     out.runs.clear();
     for (const BenchRow& r : repetitions)
         out.runs.push_back({r.nativeSeconds, r.povSeconds, r.nativeRss, r.povRss, r.povOk});

@@ -40,6 +40,8 @@ struct BenchRow {
     std::optional<uint64_t> primitives;
     double nativeCommandSeconds = 0;  // the whole `pcsg render` command's wall time
     std::optional<EmbreeRun> embree;  // a triangle-only scene that pcsg-embree traced
+    // The same rays through pcsg's tracer (pcsg-trace), where Embree traced the scene.
+    std::optional<NativeTraceRun> nativeTrace;
     std::vector<SideBySideRun> runs;  // each repetition (medianRow: more than one)
 };
 
@@ -56,8 +58,8 @@ double medianOf(const std::vector<Row>& rows, F&& figure) {
 
 // The row of N repetitions of one scene: the first failed repetition as it is (its native
 // render failed), else each figure the median of the repetitions', POV-Ray's only where every
-// repetition rendered it (else the first failure's note), Embree's only where every
-// repetition traced it. `runs` gets each repetition's.
+// repetition rendered it (else the first failure's note), Embree's and pcsg-trace's only
+// where every repetition traced it. `runs` gets each repetition's.
 BenchRow medianRow(const std::vector<BenchRow>& repetitions);
 
 // "" for fewer than two ratios, else "; runs 8.94-12.58": the range of the per-run ratios,

@@ -89,6 +89,20 @@ TEST(BenchMedian, PovrayAndEmbreeOnlyWhereEveryRunHasThem) {
     EXPECT_EQ(both.embree->peakRss, 500u);
 }
 
+TEST(BenchMedian, TheNativeTraceOnlyWhereEveryRunHasIt) {
+    BenchRow a = rowOf(1.0, 20, 40, 900), b = rowOf(3.0, 20, 40, 900), c = rowOf(2.0, 20, 40, 900);
+    a.nativeTrace = NativeTraceRun{0.4, 0.1, 9e6, 900, 0};
+    b.nativeTrace = NativeTraceRun{0.8, 0.3, 3e6, 900, 5};
+    EXPECT_FALSE(medianRow({a, b, c}).nativeTrace.has_value()) << "c has none";
+    c.nativeTrace = NativeTraceRun{0.6, 0.2, 4e6, 900, 2};
+    const BenchRow m = medianRow({a, b, c});
+    ASSERT_TRUE(m.nativeTrace.has_value());
+    EXPECT_DOUBLE_EQ(m.nativeTrace->buildSeconds, 0.6);
+    EXPECT_DOUBLE_EQ(m.nativeTrace->traceSeconds, 0.2);
+    EXPECT_DOUBLE_EQ(m.nativeTrace->raysPerSecond, 4e6) << "the median, not the first";
+    EXPECT_EQ(m.nativeTrace->rays, 900u);
+}
+
 TEST(BenchMedian, AnimationRowsTakeTheMedianOfBothSides) {
     auto row = [](double native, double pov, uint64_t rss) {
         AnimationRow a;

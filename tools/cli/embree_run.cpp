@@ -12,20 +12,37 @@
 
 namespace pcsg::tools {
 
-std::optional<std::string> findEmbree() {
+namespace {
+
+// The program `name` beside this executable, if it is there and executable.
+std::optional<std::string> findBeside(const char* name) {
     const std::filesystem::path self = selfExecutable();
     if (!self.has_parent_path()) return std::nullopt;
-    const std::filesystem::path beside = self.parent_path() / "pcsg-embree";
+    const std::filesystem::path beside = self.parent_path() / name;
     if (access(beside.c_str(), X_OK) != 0) return std::nullopt;
     return beside.string();
 }
 
+int threadsOrCores(int threads) {
+    if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
+    return std::max(threads, 1);
+}
+
+}  // namespace
+
+std::optional<std::string> findEmbree() {
+    return findBeside("pcsg-embree");
+}
+
+std::optional<std::string> findNativeTrace() {
+    return findBeside("pcsg-trace");
+}
+
 std::optional<EmbreeRun> runEmbree(const std::string& embree, const std::string& scene, int width,
                                    int height, int threads, uint64_t maxNodes) {
-    if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
     const ChildResult c =
         runChild({embree, scene, "--json", "--width", std::to_string(width), "--height",
-                  std::to_string(height), "--threads", std::to_string(std::max(threads, 1)),
+                  std::to_string(height), "--threads", std::to_string(threadsOrCores(threads)),
                   "--max-nodes", std::to_string(maxNodes)});
     if (c.exitCode != 0) return std::nullopt;
     const auto j = nlohmann::json::parse(c.out, nullptr, false);
@@ -38,6 +55,23 @@ std::optional<EmbreeRun> runEmbree(const std::string& embree, const std::string&
     e.seconds = c.seconds;
     e.peakRss = c.peakRssBytes;
     return e;
+}
+
+std::optional<NativeTraceRun> runNativeTrace(const std::string& trace, const std::string& scene,
+                                             int width, int height, int threads) {
+    const ChildResult c =
+        runChild({trace, scene, "--json", "--width", std::to_string(width), "--height",
+                  std::to_string(height), "--threads", std::to_string(threadsOrCores(threads))});
+    if (c.exitCode != 0) return std::nullopt;
+    const auto j = nlohmann::json::parse(c.out, nullptr, false);
+    if (!j.is_object()) return std::nullopt;
+    NativeTraceRun n;
+    n.buildSeconds = j.value("build_seconds", 0.0);
+    n.traceSeconds = j.value("trace_seconds", 0.0);
+    n.raysPerSecond = j.value("rays_per_second", 0.0);
+    n.rays = j.value("rays", uint64_t{0});
+    n.traceExpansions = j.value("trace_expansions", uint64_t{0});
+    return n;
 }
 
 }  // namespace pcsg::tools

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# pcsg-trace on the Sierpinski tetrahedron of order 8 at a small size: the timed render
+# traces exactly the rays of the build render (the same pixel centres and shadow rays),
+# every camera ray at least, and its rate is its rays over its time; the order's two
+# expansions fit the cache, so none is built again. A scene that does not compile exits
+# with 1, a bad command line with 2.
+#   trace_bench_test.sh PCSG_TRACE SIERPINSKI_8
+set -euo pipefail
+trace=$1 scene=$2
+out=$("$trace" "$scene" --width 64 --height 48 --threads 2 --json)
+python3 - "$out" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+assert j["rays"] == j["build_rays"], j  # the same rays, twice
+assert j["rays"] >= 64 * 48, j          # every pixel centre, and shadow rays for the hits
+assert j["rays"] > 64 * 48, j           # the tetrahedron is in view: some hits
+assert j["build_expansions"] > 0 and j["trace_expansions"] == 0, j
+assert j["trace_seconds"] > 0 and j["build_seconds"] > 0 and j["peak_rss_bytes"] > 0, j
+rate = j["rays"] / j["trace_seconds"]
+assert abs(j["rays_per_second"] - rate) <= 1e-6 * rate, j
+print("pcsg-trace:", j["rays"], "rays at", round(j["rays_per_second"]), "rays/s")
+PY
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+printf 'sphere {\n' >"$dir/broken.pcsg"
+status=0
+"$trace" "$dir/broken.pcsg" --width 8 --height 6 2>"$dir/err" || status=$?
+if [[ $status != 1 ]] || ! grep -q "broken.pcsg" "$dir/err"; then
+    echo "expected exit status 1 and a message naming the scene, got $status:" >&2
+    cat "$dir/err" >&2
+    exit 1
+fi
+status=0
+"$trace" "$scene" --width 0 2>"$dir/err" || status=$?
+if [[ $status != 2 ]]; then
+    echo "expected exit status 2 for --width 0, got $status" >&2
+    exit 1
+fi
+echo "a broken scene: exit 1; --width 0: exit 2"
