@@ -609,7 +609,8 @@ void addBenchCommand(CLI::App& app, int& status) {
         "tree (one `pcsg render\n"
         "--frames` command against one `povray` command on the exported frames' .ini). When\n"
         "pcsg-embree is beside pcsg (built when Embree 3 is found), triangle-only scenes are\n"
-        "also traced by Embree on the expanded mesh, the yardstick. Microbenchmarks\n"
+        "also traced by Embree on the expanded mesh, the yardstick, and by pcsg-trace (the same\n"
+        "rays through pcsg's tracer, after its own build) for the trace rates. Microbenchmarks\n"
         "of the hot paths are the separate pcsg_microbench program (Google Benchmark).");
     cmd->add_option("scenes", o->scenes, "Scene files (.pcsg)");
     cmd->add_option("--width", o->width, "Image width")
