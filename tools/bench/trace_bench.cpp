@@ -7,9 +7,9 @@
 //    (no anti-aliasing), which fills what pcsg builds as rays ask for it (the exact boxes
 //    of S-node instances, the expanded instances, the two-level structure);
 //  - trace: the same render again on the same renderer (tracer/render.h's RegionRenderer,
-//    whose caches persist from region to region), timed alone. Whatever the caches'
-//    budgets evicted is built again in it, and counted: pcsg's memory bounds are part of
-//    its trace rate.
+//    whose caches persist from region to region), timed alone, --passes times (5), the
+//    trace time the median pass's (as pcsg-embree's). Whatever the caches' budgets evicted
+//    is built again in it, and counted: pcsg's memory bounds are part of its trace rate.
 //
 // The render shades each hit as `pcsg render` does (shadow rays toward each light that
 // the surface faces, and the colour), work that Embree's loop does not do; so the rate is
@@ -26,7 +26,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
+#include "bench_median.h"
 #include "render.h"
 #include "scene_input.h"
 
@@ -44,12 +46,16 @@ struct Options {
     int width = 640, height = 480;
     int threads = 2;
     bool json = false;
+    int passes = 5;
 };
 
 struct Figures {
-    double compileSeconds = 0, buildSeconds = 0, traceSeconds = 0;
-    uint64_t buildRays = 0, rays = 0;
-    uint64_t buildExpansions = 0, traceExpansions = 0;  // instances expanded in each pass
+    double compileSeconds = 0, buildSeconds = 0;
+    double traceSeconds = 0;  // the median timed pass's
+    std::vector<double> passSeconds;
+    uint64_t buildRays = 0, rays = 0;  // the build render's, a timed pass's
+    // Instances expanded in the build render, and again in the timed passes (their median).
+    uint64_t buildExpansions = 0, traceExpansions = 0;
     uint64_t peakRssBytes = 0;
 };
 
@@ -71,6 +77,8 @@ void print(const Options& o, const Figures& f) {
                                   {"build_rays", f.buildRays},
                                   {"build_expansions", f.buildExpansions},
                                   {"trace_seconds", f.traceSeconds},
+                                  {"passes", o.passes},
+                                  {"pass_seconds", f.passSeconds},
                                   {"trace_expansions", f.traceExpansions},
                                   {"rays", f.rays},
                                   {"rays_per_second", raysPerSecond},
@@ -81,14 +89,14 @@ void print(const Options& o, const Figures& f) {
     std::cout << fmt::format(
         "scene:           {}\nimage:           {}x{}, {} threads\n"
         "compile time:    {:.3f} s\nbuild time:      {:.3f} s ({} instances expanded)\n"
-        "trace time:      {:.3f} s ({} instances expanded again)\n"
+        "trace time:      {:.3f} s, the median of {} passes ({} instances expanded again each)\n"
         "rays:            {}\nrays/s:          {:.0f}\npeak RSS:        {:.1f} MB\n",
         o.scene, o.width, o.height, o.threads, f.compileSeconds, f.buildSeconds, f.buildExpansions,
-        f.traceSeconds, f.traceExpansions, f.rays, raysPerSecond, f.peakRssBytes / 1e6);
+        f.traceSeconds, o.passes, f.traceExpansions, f.rays, raysPerSecond, f.peakRssBytes / 1e6);
 }
 
-// The build pass and the timed pass over the image's pixel centres.
-void traceTwice(const Graph& g, const Options& o, Figures& f) {
+// The build render and the timed passes over the image's pixel centres.
+void traceTimed(const Graph& g, const Options& o, Figures& f) {
     tracer::RenderOptions ro;
     ro.width = o.width, ro.height = o.height, ro.threads = o.threads;
     const tracer::Region image{0, 0, o.width, o.height};
@@ -97,14 +105,20 @@ void traceTwice(const Graph& g, const Options& o, Figures& f) {
     tracer::RegionRenderer renderer(g, ro);
     renderer.render(image, discard);
     f.buildSeconds = secondsSince(start);
-    const tracer::RenderResult built = renderer.figures();
-    f.buildRays = built.rays, f.buildExpansions = built.expansions;
-    start = Clock::now();
-    renderer.render(image, discard);
-    f.traceSeconds = secondsSince(start);
-    const tracer::RenderResult traced = renderer.figures();
-    f.rays = traced.rays - built.rays;
-    f.traceExpansions = traced.expansions - built.expansions;
+    tracer::RenderResult before = renderer.figures();
+    f.buildRays = before.rays, f.buildExpansions = before.expansions;
+    std::vector<double> expansions;
+    for (int pass = 0; pass < o.passes; ++pass) {
+        start = Clock::now();
+        renderer.render(image, discard);
+        f.passSeconds.push_back(secondsSince(start));
+        const tracer::RenderResult after = renderer.figures();
+        f.rays = after.rays - before.rays;
+        expansions.push_back(double(after.expansions - before.expansions));
+        before = after;
+    }
+    f.traceSeconds = tools::median(f.passSeconds);
+    f.traceExpansions = static_cast<uint64_t>(tools::median(expansions));
 }
 
 int run(const Options& o) {
@@ -115,7 +129,7 @@ int run(const Options& o) {
     Figures f;
     f.compileSeconds = compiled.seconds;
     try {
-        traceTwice(*compiled.graph, o, f);
+        traceTimed(*compiled.graph, o, f);
     } catch (const std::exception& e) {
         std::cerr << "pcsg-trace: " << o.scene << ": " << e.what() << "\n";
         return 1;
@@ -131,8 +145,8 @@ int run(const Options& o) {
 int main(int argc, char** argv) {
     pcsg::trace_bench::Options o;
     CLI::App app{
-        "Trace a pcsg scene's pixel centres twice with pcsg's own tracer, the first time to "
-        "build what it builds as rays ask, and time the second (the native side of `pcsg "
+        "Trace a pcsg scene's pixel centres with pcsg's own tracer, once to build what it "
+        "builds as rays ask, then --passes times, timed (the native side of `pcsg "
         "bench`'s trace rate against pcsg-embree): one camera ray per pixel centre and a "
         "shadow ray per hit and light."};
     app.add_option("scene", o.scene, "Scene file (.pcsg)")->required();
@@ -143,6 +157,10 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     app.add_option("--threads", o.threads, "Threads")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_option("--passes", o.passes,
+                   "Timed renders after the build; the trace time is the median one's")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     app.add_flag("--json", o.json, "Print the figures as JSON");

@@ -15,6 +15,8 @@ assert j["rays"] == j["build_rays"], j  # the same rays, twice
 assert j["rays"] >= 64 * 48, j          # every pixel centre, and shadow rays for the hits
 assert j["rays"] > 64 * 48, j           # the tetrahedron is in view: some hits
 assert j["build_expansions"] > 0 and j["trace_expansions"] == 0, j
+assert j["passes"] == 5 and len(j["pass_seconds"]) == 5, j
+assert sorted(j["pass_seconds"])[2] == j["trace_seconds"], j  # the median pass
 assert j["trace_seconds"] > 0 and j["build_seconds"] > 0 and j["peak_rss_bytes"] > 0, j
 rate = j["rays"] / j["trace_seconds"]
 assert abs(j["rays_per_second"] - rate) <= 1e-6 * rate, j
