@@ -17,14 +17,12 @@
 // with an intersection or difference (Embree traces surfaces, not CSG).
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
-#include <sys/resource.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -32,37 +30,28 @@
 #include <string>
 #include <vector>
 
-#include "bench_median.h"
 #include "camera.h"
 #include "expander.h"
 #include "primitive_table.h"
 #include "scene_input.h"
+#include "yardstick.h"
 
 namespace pcsg::embree_bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using yardstick::Clock;
+using yardstick::secondsSince;
 
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-struct Options {
-    std::string scene;
-    int width = 640, height = 480;
-    int threads = 2;
+struct Options : yardstick::TraceOptions {
     uint64_t maxNodes = 10'000'000;
-    bool json = false;
     bool single = false;  // one ray at a time instead of packets of 8
-    int passes = 5;       // the rays traced this many times, the rate of the median pass
 };
 
 struct Figures {
     uint64_t triangles = 0;
     double expandSeconds = 0, buildSeconds = 0;
-    double traceSeconds = 0;          // the median pass's
-    std::vector<double> passSeconds;  // each pass's
-    uint64_t rays = 0, hits = 0;
+    yardstick::Passes passes;
+    uint64_t hits = 0;  // of a pass's camera rays
     uint64_t peakRssBytes = 0;
 };
 
@@ -199,7 +188,7 @@ void trace(RTCScene scene, const Scene& s, const Options& o, Figures& f) {
             }
         rays += localRays, hits += localHits, lit += localLit;
     });
-    f.rays = rays, f.hits = hits;
+    f.passes.rays = rays, f.hits = hits;
 }
 
 // Packets of 8 (the default): the camera rays of a 4 x 2 block of pixels in one
@@ -279,42 +268,28 @@ void tracePackets(RTCScene scene, const Scene& s, const Options& o, Figures& f) 
                 }
             rays += localRays, hits += localHits;
         });
-    f.rays = rays, f.hits = hits;
-}
-
-uint64_t peakRssBytes() {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return uint64_t(u.ru_maxrss) * 1024;  // Linux: kilobytes
+    f.passes.rays = rays, f.hits = hits;
 }
 
 void print(const Options& o, const Figures& f) {
-    const double raysPerSecond = f.traceSeconds > 0 ? f.rays / f.traceSeconds : 0;
     if (o.json) {
-        const nlohmann::json j = {{"scene", o.scene},
-                                  {"width", o.width},
-                                  {"height", o.height},
-                                  {"threads", o.threads},
-                                  {"triangles", f.triangles},
-                                  {"expand_seconds", f.expandSeconds},
-                                  {"build_seconds", f.buildSeconds},
-                                  {"trace_seconds", f.traceSeconds},
-                                  {"passes", o.passes},
-                                  {"pass_seconds", f.passSeconds},
-                                  {"packets", !o.single},
-                                  {"rays", f.rays},
-                                  {"hits", f.hits},
-                                  {"rays_per_second", raysPerSecond},
-                                  {"peak_rss_bytes", f.peakRssBytes}};
+        nlohmann::json j = yardstick::traceJson(o, f.passes, f.peakRssBytes);
+        j["triangles"] = f.triangles;
+        j["expand_seconds"] = f.expandSeconds;
+        j["build_seconds"] = f.buildSeconds;
+        j["packets"] = !o.single;
+        j["hits"] = f.hits;
         std::cout << j.dump(2) << "\n";
         return;
     }
     std::cout << fmt::format(
         "scene:           {}\nimage:           {}x{}, {} threads\ntriangles:       {}\n"
-        "expand time:     {:.3f} s\nbuild time:      {:.3f} s\ntrace time:      {:.3f} s\n"
+        "expand time:     {:.3f} s\nbuild time:      {:.3f} s\n"
+        "trace time:      {:.3f} s, the median of {} passes ({})\n"
         "rays:            {}\nrays/s:          {:.0f}\npeak RSS:        {:.1f} MB\n",
         o.scene, o.width, o.height, o.threads, f.triangles, f.expandSeconds, f.buildSeconds,
-        f.traceSeconds, f.rays, raysPerSecond, f.peakRssBytes / 1e6);
+        f.passes.median(), o.passes, o.single ? "one ray at a time" : "packets of 8", f.passes.rays,
+        f.passes.raysPerSecond(), f.peakRssBytes / 1e6);
 }
 
 // Expands the scene; nothing (with the message printed) when it cannot be traced as a
@@ -363,10 +338,9 @@ int run(const Options& o) {
             trace(scene, compiled.graph->scene, o, f);
         else
             tracePackets(scene, compiled.graph->scene, o, f);
-        f.passSeconds.push_back(secondsSince(start));
+        f.passes.seconds.push_back(secondsSince(start));
     }
-    f.traceSeconds = tools::median(f.passSeconds);
-    f.peakRssBytes = peakRssBytes();
+    f.peakRssBytes = yardstick::peakRssBytes();
     rtcReleaseScene(scene);
     rtcReleaseDevice(device);
     print(o, f);
@@ -381,33 +355,13 @@ int main(int argc, char** argv) {
     CLI::App app{
         "Trace a triangle-only pcsg scene with Embree 3 on its expanded mesh (the yardstick of "
         "`pcsg bench`): one camera ray per pixel centre and one shadow ray per hit and light."};
-    app.add_option("scene", o.scene, "Scene file (.pcsg)")->required();
-    app.add_option("--width", o.width, "Image width")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    app.add_option("--height", o.height, "Image height")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    app.add_option("--threads", o.threads, "Threads")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+    pcsg::yardstick::addTraceOptions(app, o);
     app.add_option("--max-nodes", o.maxNodes, "Expansion budget")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    app.add_flag("--json", o.json, "Print the figures as JSON");
-    app.add_option("--passes", o.passes,
-                   "Trace the rays this many times after the build; the trace time is the "
-                   "median pass's")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     app.add_flag("--single", o.single,
                  "Trace one ray at a time (rtcIntersect1 and rtcOccluded1) instead of packets "
                  "of 8 (rtcIntersect8 on 4 x 2 pixels, rtcOccluded8 for their shadow rays)");
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        const int code = app.exit(e);
-        return code == 0 ? 0 : 2;
-    }
+    if (const int status = pcsg::yardstick::parse(app, argc, argv); status >= 0) return status;
     return pcsg::embree_bench::run(o);
 }

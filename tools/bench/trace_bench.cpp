@@ -19,84 +19,53 @@
 // Exit status: 0 done; 1 the scene did not compile or its render met a run-time error;
 // 2 a bad command line.
 #include <fmt/format.h>
-#include <sys/resource.h>
 
-#include <CLI/CLI.hpp>
-#include <chrono>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "bench_median.h"
 #include "render.h"
 #include "scene_input.h"
+#include "yardstick.h"
 
 namespace pcsg::trace_bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-struct Options {
-    std::string scene;
-    int width = 640, height = 480;
-    int threads = 2;
-    bool json = false;
-    int passes = 5;
-};
+using yardstick::Clock;
+using yardstick::secondsSince;
 
 struct Figures {
     double compileSeconds = 0, buildSeconds = 0;
-    double traceSeconds = 0;  // the median timed pass's
-    std::vector<double> passSeconds;
-    uint64_t buildRays = 0, rays = 0;  // the build render's, a timed pass's
-    // Instances expanded in the build render, and again in the timed passes (their median).
+    uint64_t buildRays = 0;
+    yardstick::Passes passes;
+    // Instances expanded in the build render, and again in a timed pass (their median).
     uint64_t buildExpansions = 0, traceExpansions = 0;
     uint64_t peakRssBytes = 0;
 };
 
-uint64_t peakRssBytes() {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return uint64_t(u.ru_maxrss) * 1024;  // Linux: kilobytes
-}
-
-void print(const Options& o, const Figures& f) {
-    const double raysPerSecond = f.traceSeconds > 0 ? f.rays / f.traceSeconds : 0;
+void print(const yardstick::TraceOptions& o, const Figures& f) {
     if (o.json) {
-        const nlohmann::json j = {{"scene", o.scene},
-                                  {"width", o.width},
-                                  {"height", o.height},
-                                  {"threads", o.threads},
-                                  {"compile_seconds", f.compileSeconds},
-                                  {"build_seconds", f.buildSeconds},
-                                  {"build_rays", f.buildRays},
-                                  {"build_expansions", f.buildExpansions},
-                                  {"trace_seconds", f.traceSeconds},
-                                  {"passes", o.passes},
-                                  {"pass_seconds", f.passSeconds},
-                                  {"trace_expansions", f.traceExpansions},
-                                  {"rays", f.rays},
-                                  {"rays_per_second", raysPerSecond},
-                                  {"peak_rss_bytes", f.peakRssBytes}};
+        nlohmann::json j = yardstick::traceJson(o, f.passes, f.peakRssBytes);
+        j["compile_seconds"] = f.compileSeconds;
+        j["build_seconds"] = f.buildSeconds;
+        j["build_rays"] = f.buildRays;
+        j["build_expansions"] = f.buildExpansions;
+        j["trace_expansions"] = f.traceExpansions;
         std::cout << j.dump(2) << "\n";
         return;
     }
     std::cout << fmt::format(
         "scene:           {}\nimage:           {}x{}, {} threads\n"
         "compile time:    {:.3f} s\nbuild time:      {:.3f} s ({} instances expanded)\n"
-        "trace time:      {:.3f} s, the median of {} passes ({} instances expanded again each)\n"
-        "rays:            {}\nrays/s:          {:.0f}\npeak RSS:        {:.1f} MB\n",
+        "trace time:      {:.3f} s, the median of {} passes ({} instances expanded again "
+        "each)\nrays:            {}\nrays/s:          {:.0f}\npeak RSS:        {:.1f} MB\n",
         o.scene, o.width, o.height, o.threads, f.compileSeconds, f.buildSeconds, f.buildExpansions,
-        f.traceSeconds, o.passes, f.traceExpansions, f.rays, raysPerSecond, f.peakRssBytes / 1e6);
+        f.passes.median(), o.passes, f.traceExpansions, f.passes.rays, f.passes.raysPerSecond(),
+        f.peakRssBytes / 1e6);
 }
 
 // The build render and the timed passes over the image's pixel centres.
-void traceTimed(const Graph& g, const Options& o, Figures& f) {
+void traceTimed(const Graph& g, const yardstick::TraceOptions& o, Figures& f) {
     tracer::RenderOptions ro;
     ro.width = o.width, ro.height = o.height, ro.threads = o.threads;
     const tracer::Region image{0, 0, o.width, o.height};
@@ -111,17 +80,16 @@ void traceTimed(const Graph& g, const Options& o, Figures& f) {
     for (int pass = 0; pass < o.passes; ++pass) {
         start = Clock::now();
         renderer.render(image, discard);
-        f.passSeconds.push_back(secondsSince(start));
+        f.passes.seconds.push_back(secondsSince(start));
         const tracer::RenderResult after = renderer.figures();
-        f.rays = after.rays - before.rays;
+        f.passes.rays = after.rays - before.rays;
         expansions.push_back(double(after.expansions - before.expansions));
         before = after;
     }
-    f.traceSeconds = tools::median(f.passSeconds);
     f.traceExpansions = static_cast<uint64_t>(tools::median(expansions));
 }
 
-int run(const Options& o) {
+int run(const yardstick::TraceOptions& o) {
     tools::CompiledScene compiled = tools::compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
     // (as `pcsg render` without --clock: clock 0, frame 1)
@@ -134,7 +102,7 @@ int run(const Options& o) {
         std::cerr << "pcsg-trace: " << o.scene << ": " << e.what() << "\n";
         return 1;
     }
-    f.peakRssBytes = peakRssBytes();
+    f.peakRssBytes = yardstick::peakRssBytes();
     print(o, f);
     return 0;
 }
@@ -143,32 +111,13 @@ int run(const Options& o) {
 }  // namespace pcsg::trace_bench
 
 int main(int argc, char** argv) {
-    pcsg::trace_bench::Options o;
+    pcsg::yardstick::TraceOptions o;
     CLI::App app{
         "Trace a pcsg scene's pixel centres with pcsg's own tracer, once to build what it "
         "builds as rays ask, then --passes times, timed (the native side of `pcsg "
         "bench`'s trace rate against pcsg-embree): one camera ray per pixel centre and a "
         "shadow ray per hit and light."};
-    app.add_option("scene", o.scene, "Scene file (.pcsg)")->required();
-    app.add_option("--width", o.width, "Image width")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    app.add_option("--height", o.height, "Image height")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    app.add_option("--threads", o.threads, "Threads")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    app.add_option("--passes", o.passes,
-                   "Timed renders after the build; the trace time is the median one's")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    app.add_flag("--json", o.json, "Print the figures as JSON");
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        const int code = app.exit(e);
-        return code == 0 ? 0 : 2;
-    }
+    pcsg::yardstick::addTraceOptions(app, o);
+    if (const int status = pcsg::yardstick::parse(app, argc, argv); status >= 0) return status;
     return pcsg::trace_bench::run(o);
 }
