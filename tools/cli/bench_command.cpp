@@ -8,8 +8,8 @@
 // yardstick of the native renderer: its build and trace times, rays per second and peak
 // RSS fill four more columns, and three more targets compare the two. The trace rates are
 // compared on the same rays, each after its own build: Embree's against pcsg-trace's
-// (tools/bench/trace_bench.cpp), which renders the same pixel centres twice and times the
-// second, in a fifth column.
+// (tools/bench/trace_bench.cpp), which renders the same pixel centres once to build and
+// then times further renders, in a fifth column.
 #include <fmt/format.h>
 #include <sys/utsname.h>
 #include <unistd.h>
@@ -180,7 +180,7 @@ Target traceRateTarget(const BenchRow& r) {
     if (r.nativeTrace)
         how = fmt::format(
             "the same rays, each after its build; {} instances expanded again in "
-            "the timed render; pcsg render's rate {:.0f}",
+            "each timed render; pcsg render's rate {:.0f}",
             r.nativeTrace->traceExpansions, r.raysPerSecond.value_or(0));
     return {
         fmt::format("{} native trace rate within 3x of Embree's ({:.0f} against {:.0f} rays/s: "
