@@ -43,7 +43,11 @@ struct Figures {
     uint64_t peakRssBytes = 0;
 };
 
-void print(const yardstick::TraceOptions& o, const Figures& f) {
+struct Options : yardstick::TraceOptions {
+    size_t expansionCacheMb = 16;  // pcsg render's --expansion-cache-mb
+};
+
+void print(const Options& o, const Figures& f) {
     if (o.json) {
         nlohmann::json j = yardstick::traceJson(o, f.passes, f.peakRssBytes);
         j["compile_seconds"] = f.compileSeconds;
@@ -51,6 +55,7 @@ void print(const yardstick::TraceOptions& o, const Figures& f) {
         j["build_rays"] = f.buildRays;
         j["build_expansions"] = f.buildExpansions;
         j["trace_expansions"] = f.traceExpansions;
+        j["expansion_cache_mb"] = o.expansionCacheMb;
         std::cout << j.dump(2) << "\n";
         return;
     }
@@ -65,9 +70,10 @@ void print(const yardstick::TraceOptions& o, const Figures& f) {
 }
 
 // The build render and the timed passes over the image's pixel centres.
-void traceTimed(const Graph& g, const yardstick::TraceOptions& o, Figures& f) {
+void traceTimed(const Graph& g, const Options& o, Figures& f) {
     tracer::RenderOptions ro;
     ro.width = o.width, ro.height = o.height, ro.threads = o.threads;
+    ro.expansionBytes = o.expansionCacheMb << 20;
     const tracer::Region image{0, 0, o.width, o.height};
     const tracer::RowSink discard = [](int, std::span<const float>) {};
     Clock::time_point start = Clock::now();
@@ -89,7 +95,7 @@ void traceTimed(const Graph& g, const yardstick::TraceOptions& o, Figures& f) {
     f.traceExpansions = static_cast<uint64_t>(tools::median(expansions));
 }
 
-int run(const yardstick::TraceOptions& o) {
+int run(const Options& o) {
     tools::CompiledScene compiled = tools::compileScene(o.scene, std::cerr);
     if (!compiled.graph) return 1;
     // (as `pcsg render` without --clock: clock 0, frame 1)
@@ -111,13 +117,18 @@ int run(const yardstick::TraceOptions& o) {
 }  // namespace pcsg::trace_bench
 
 int main(int argc, char** argv) {
-    pcsg::yardstick::TraceOptions o;
+    pcsg::trace_bench::Options o;
     CLI::App app{
         "Trace a pcsg scene's pixel centres with pcsg's own tracer, once to build what it "
         "builds as rays ask, then --passes times, timed (the native side of `pcsg "
         "bench`'s trace rate against pcsg-embree): one camera ray per pixel centre and a "
         "shadow ray per hit and light."};
     pcsg::yardstick::addTraceOptions(app, o);
+    app.add_option("--expansion-cache-mb", o.expansionCacheMb,
+                   "Memory limit in MB of the cache of expanded sub-graph instances, as for pcsg "
+                   "render (0: none)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
     if (const int status = pcsg::yardstick::parse(app, argc, argv); status >= 0) return status;
     return pcsg::trace_bench::run(o);
 }

@@ -2,8 +2,8 @@
 # pcsg-trace on the Sierpinski tetrahedron of order 8 at a small size: the timed render
 # traces exactly the rays of the build render (the same pixel centres and shadow rays),
 # every camera ray at least, and its rate is its rays over its time; the order's two
-# expansions fit the cache, so none is built again. A scene that does not compile exits
-# with 1, a bad command line with 2.
+# expansions fit the cache, so none is built again; without the cache none is built at
+# all. A scene that does not compile exits with 1, a bad command line with 2.
 #   trace_bench_test.sh PCSG_TRACE SIERPINSKI_8
 set -euo pipefail
 trace=$1 scene=$2
@@ -21,6 +21,17 @@ assert j["trace_seconds"] > 0 and j["build_seconds"] > 0 and j["peak_rss_bytes"]
 rate = j["rays"] / j["trace_seconds"]
 assert abs(j["rays_per_second"] - rate) <= 1e-6 * rate, j
 print("pcsg-trace:", j["rays"], "rays at", round(j["rays_per_second"]), "rays/s")
+PY
+# Without the expansion cache (as pcsg render --expansion-cache-mb 0): nothing expanded,
+# and the same rays.
+bare=$("$trace" "$scene" --width 64 --height 48 --threads 2 --passes 1 --expansion-cache-mb 0 --json)
+python3 - "$out" "$bare" <<'PY'
+import json, sys
+j, b = json.loads(sys.argv[1]), json.loads(sys.argv[2])
+assert b["expansion_cache_mb"] == 0 and j["expansion_cache_mb"] == 16, (b, j)
+assert b["build_expansions"] == 0 and b["trace_expansions"] == 0, b
+assert b["rays"] == j["rays"] and len(b["pass_seconds"]) == 1, (b, j)
+print("without expansions:", b["rays"], "rays, none expanded")
 PY
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
