@@ -144,19 +144,32 @@ RTCRayHit cameraRay(const tracer::PinholeCamera& camera, int px, int py) {
     return rh;
 }
 
+// The shadow ray from the hit at t along the ray (o, d) toward the light: its direction
+// reaches the light at t = 1, and it starts a little off the surface.
+struct ShadowRay {
+    float org[3], dir[3], tnear;
+};
+
+ShadowRay shadowRayFrom(const float o[3], const float d[3], float t, const Light& light) {
+    ShadowRay s;
+    for (int a = 0; a < 3; ++a) s.org[a] = o[a] + t * d[a];
+    s.dir[0] = float(light.position.x) - s.org[0];
+    s.dir[1] = float(light.position.y) - s.org[1];
+    s.dir[2] = float(light.position.z) - s.org[2];
+    const float length = std::sqrt(s.dir[0] * s.dir[0] + s.dir[1] * s.dir[1] + s.dir[2] * s.dir[2]);
+    s.tnear = length > 0 ? 1e-4f / length : 0;
+    return s;
+}
+
 // One shadow ray from the hit toward the light: true when something is in the way.
 bool shadowed(RTCScene scene, const RTCRayHit& rh, const Light& light) {
-    const float t = rh.ray.tfar;
-    const float p[3] = {rh.ray.org_x + t * rh.ray.dir_x, rh.ray.org_y + t * rh.ray.dir_y,
-                        rh.ray.org_z + t * rh.ray.dir_z};
-    const float d[3] = {float(light.position.x) - p[0], float(light.position.y) - p[1],
-                        float(light.position.z) - p[2]};
+    const float o[3] = {rh.ray.org_x, rh.ray.org_y, rh.ray.org_z};
+    const float d[3] = {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
+    const ShadowRay s = shadowRayFrom(o, d, rh.ray.tfar, light);
     RTCRay ray{};
-    ray.org_x = p[0], ray.org_y = p[1], ray.org_z = p[2];
-    ray.dir_x = d[0], ray.dir_y = d[1], ray.dir_z = d[2];
-    // The direction reaches the light at t = 1; start a little off the surface.
-    const float length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    ray.tnear = length > 0 ? 1e-4f / length : 0;
+    ray.org_x = s.org[0], ray.org_y = s.org[1], ray.org_z = s.org[2];
+    ray.dir_x = s.dir[0], ray.dir_y = s.dir[1], ray.dir_z = s.dir[2];
+    ray.tnear = s.tnear;
     ray.tfar = 1;
     ray.mask = ~0u;
     RTCIntersectContext context;
@@ -203,35 +216,28 @@ void cameraPacket(const tracer::PinholeCamera& camera, int x0, int y0, const Opt
     for (int k = 0; k < 8; ++k) {
         const int px = x0 + k % 4, py = y0 + k / 4;
         lanes.valid[k] = px < o.width && py < o.height ? -1 : 0;
-        const tracer::Ray r = camera.ray(px + 0.5, py + 0.5);
-        rh.ray.org_x[k] = float(r.origin.x), rh.ray.org_y[k] = float(r.origin.y);
-        rh.ray.org_z[k] = float(r.origin.z);
-        rh.ray.dir_x[k] = float(r.dir.x), rh.ray.dir_y[k] = float(r.dir.y);
-        rh.ray.dir_z[k] = float(r.dir.z);
-        rh.ray.tnear[k] = 0, rh.ray.tfar[k] = INFINITY, rh.ray.time[k] = 0;
-        rh.ray.mask[k] = ~0u, rh.ray.id[k] = 0, rh.ray.flags[k] = 0;
+        const RTCRay r = cameraRay(camera, px, py).ray;
+        rh.ray.org_x[k] = r.org_x, rh.ray.org_y[k] = r.org_y, rh.ray.org_z[k] = r.org_z;
+        rh.ray.dir_x[k] = r.dir_x, rh.ray.dir_y[k] = r.dir_y, rh.ray.dir_z[k] = r.dir_z;
+        rh.ray.tnear[k] = r.tnear, rh.ray.tfar[k] = r.tfar, rh.ray.time[k] = 0;
+        rh.ray.mask[k] = r.mask, rh.ray.id[k] = 0, rh.ray.flags[k] = 0;
         rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
     }
 }
 
-// The shadow rays of the packet's hits toward the light (as shadowed() makes each one);
-// returns the lanes traced.
+// The shadow rays of the packet's hits toward the light (shadowRayFrom, as shadowed()
+// makes each one); returns the lanes traced.
 int shadowPacket(RTCScene scene, RTCIntersectContext& context, const RTCRayHit8& rh,
                  const Lanes& hits, const Light& light) {
     RTCRay8 ray{};
     int traced = 0;
     for (int k = 0; k < 8; ++k) {
-        const float t = rh.ray.tfar[k];
-        const float p[3] = {rh.ray.org_x[k] + t * rh.ray.dir_x[k],
-                            rh.ray.org_y[k] + t * rh.ray.dir_y[k],
-                            rh.ray.org_z[k] + t * rh.ray.dir_z[k]};
-        const float d[3] = {float(light.position.x) - p[0], float(light.position.y) - p[1],
-                            float(light.position.z) - p[2]};
-        ray.org_x[k] = p[0], ray.org_y[k] = p[1], ray.org_z[k] = p[2];
-        ray.dir_x[k] = d[0], ray.dir_y[k] = d[1], ray.dir_z[k] = d[2];
-        const float length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        ray.tnear[k] = length > 0 ? 1e-4f / length : 0;
-        ray.tfar[k] = 1, ray.mask[k] = ~0u;
+        const float o[3] = {rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]};
+        const float d[3] = {rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]};
+        const ShadowRay s = shadowRayFrom(o, d, rh.ray.tfar[k], light);
+        ray.org_x[k] = s.org[0], ray.org_y[k] = s.org[1], ray.org_z[k] = s.org[2];
+        ray.dir_x[k] = s.dir[0], ray.dir_y[k] = s.dir[1], ray.dir_z[k] = s.dir[2];
+        ray.tnear[k] = s.tnear, ray.tfar[k] = 1, ray.mask[k] = ~0u;
         traced += hits.valid[k] != 0;
     }
     rtcOccluded8(hits.valid, scene, &context, &ray);

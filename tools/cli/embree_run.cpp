@@ -23,6 +23,16 @@ std::optional<std::string> findBeside(const char* name) {
     return beside.string();
 }
 
+// The program run to its end and its standard output read as a JSON object: nothing when
+// it failed or printed no object.
+std::optional<nlohmann::json> runForJson(const std::vector<std::string>& argv, ChildResult& c) {
+    c = runChild(argv);
+    if (c.exitCode != 0) return std::nullopt;
+    auto j = nlohmann::json::parse(c.out, nullptr, false);
+    if (!j.is_object()) return std::nullopt;
+    return j;
+}
+
 int threadsOrCores(int threads) {
     if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
     return std::max(threads, 1);
@@ -40,18 +50,18 @@ std::optional<std::string> findNativeTrace() {
 
 std::optional<EmbreeRun> runEmbree(const std::string& embree, const std::string& scene, int width,
                                    int height, int threads, uint64_t maxNodes) {
-    const ChildResult c =
-        runChild({embree, scene, "--json", "--width", std::to_string(width), "--height",
-                  std::to_string(height), "--threads", std::to_string(threadsOrCores(threads)),
-                  "--max-nodes", std::to_string(maxNodes)});
-    if (c.exitCode != 0) return std::nullopt;
-    const auto j = nlohmann::json::parse(c.out, nullptr, false);
-    if (!j.is_object()) return std::nullopt;
+    ChildResult c;
+    const auto j =
+        runForJson({embree, scene, "--json", "--width", std::to_string(width), "--height",
+                    std::to_string(height), "--threads", std::to_string(threadsOrCores(threads)),
+                    "--max-nodes", std::to_string(maxNodes)},
+                   c);
+    if (!j) return std::nullopt;
     EmbreeRun e;
-    e.triangles = j.value("triangles", uint64_t{0});
-    e.buildSeconds = j.value("build_seconds", 0.0);
-    e.traceSeconds = j.value("trace_seconds", 0.0);
-    e.raysPerSecond = j.value("rays_per_second", 0.0);
+    e.triangles = j->value("triangles", uint64_t{0});
+    e.buildSeconds = j->value("build_seconds", 0.0);
+    e.traceSeconds = j->value("trace_seconds", 0.0);
+    e.raysPerSecond = j->value("rays_per_second", 0.0);
     e.seconds = c.seconds;
     e.peakRss = c.peakRssBytes;
     return e;
@@ -59,18 +69,18 @@ std::optional<EmbreeRun> runEmbree(const std::string& embree, const std::string&
 
 std::optional<NativeTraceRun> runNativeTrace(const std::string& trace, const std::string& scene,
                                              int width, int height, int threads) {
-    const ChildResult c =
-        runChild({trace, scene, "--json", "--width", std::to_string(width), "--height",
-                  std::to_string(height), "--threads", std::to_string(threadsOrCores(threads))});
-    if (c.exitCode != 0) return std::nullopt;
-    const auto j = nlohmann::json::parse(c.out, nullptr, false);
-    if (!j.is_object()) return std::nullopt;
+    ChildResult c;
+    const auto j =
+        runForJson({trace, scene, "--json", "--width", std::to_string(width), "--height",
+                    std::to_string(height), "--threads", std::to_string(threadsOrCores(threads))},
+                   c);
+    if (!j) return std::nullopt;
     NativeTraceRun n;
-    n.buildSeconds = j.value("build_seconds", 0.0);
-    n.traceSeconds = j.value("trace_seconds", 0.0);
-    n.raysPerSecond = j.value("rays_per_second", 0.0);
-    n.rays = j.value("rays", uint64_t{0});
-    n.traceExpansions = j.value("trace_expansions", uint64_t{0});
+    n.buildSeconds = j->value("build_seconds", 0.0);
+    n.traceSeconds = j->value("trace_seconds", 0.0);
+    n.raysPerSecond = j->value("rays_per_second", 0.0);
+    n.rays = j->value("rays", uint64_t{0});
+    n.traceExpansions = j->value("trace_expansions", uint64_t{0});
     return n;
 }
 

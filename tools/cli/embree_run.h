@@ -31,13 +31,13 @@ std::optional<EmbreeRun> runEmbree(const std::string& embree, const std::string&
                                    int height, int threads, uint64_t maxNodes);
 
 // What pcsg-trace measured: the rays pcsg-embree traces (pixel centres, shadow rays toward
-// the lights), rendered once to build what pcsg builds as rays ask for it, then timed on a
-// second render with what the first left (whatever the caches' budgets evicted is built
-// again, and counted in the trace time).
+// the lights), rendered once to build what pcsg builds as rays ask for it, then timed on
+// further renders with what the first left, the median one's (whatever the caches' budgets
+// evicted is built again, and counted in the trace time).
 struct NativeTraceRun {
     double buildSeconds = 0, traceSeconds = 0, raysPerSecond = 0;
     uint64_t rays = 0;
-    uint64_t traceExpansions = 0;  // instances expanded again in the timed render
+    uint64_t traceExpansions = 0;  // instances expanded again in a timed render
 };
 
 // pcsg-trace on the scene at that size and thread count (0: all cores); nothing when it
