@@ -5,7 +5,7 @@
 // camera ray per pixel centre (tracer/camera.h, the scene's camera) and one shadow ray per
 // hit toward each light, on a fixed number of threads (oneTBB over bands of rows). It
 // traces packets of 8: Embree's rtcIntersect8 on blocks of 4 x 2 pixels and rtcOccluded8
-// for their shadow rays. Here they trace Sierpinski order 8 and the terrain 7-18% faster
+// for their shadow rays. Here they trace Sierpinski order 8 and the terrain 6-22% faster
 // than rtcIntersect1 and rtcOccluded1 one ray at a time (--single). The rays are traced
 // --passes times (5) and the trace time is the median pass's: one pass of 640 x 480 takes
 // Embree 15-40 ms, in which oneTBB's threads starting up and the BVH's first touches
