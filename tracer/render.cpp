@@ -531,6 +531,7 @@ RegionRenderer::RegionRenderer(const Graph& g, const RenderOptions& opt) {
     state_ = std::make_unique<State>(g, opt, std::move(bounds), boxOptionsFor(opt));
     state_->scene.useBounds = opt.useBounds;
     state_->scene.expansionBytes = opt.expansionBytes;
+    state_->scene.expansionStartBytes = opt.expansionStartBytes;
     figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     state_->figures = figures;
 }

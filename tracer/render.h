@@ -68,6 +68,9 @@ struct RenderOptions {
     // Expanded instances (unrolled_instances.h), in one cache shared by the threads that
     // holds at most this many bytes; 0: none.
     size_t expansionBytes = 16u << 20;
+    // Where that cache's budget starts (at most expansionBytes; the budget grows toward it
+    // where a larger one saves expansions).
+    size_t expansionStartBytes = size_t{2} << 20;  // (UnrollCache::kStartBytes)
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
     // Called from worker threads after each tile of each pass (1, or 2 for adaptive

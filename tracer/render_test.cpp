@@ -21,6 +21,7 @@
 #include "shading.h"
 #include "test_support.h"
 #include "traversal.h"
+#include "unroll_cache.h"
 
 namespace pcsg::tracer {
 namespace {
@@ -527,6 +528,27 @@ TEST(Render, TheTerrainsTopLevelOfDeferredCutsChangesNoPixel) {
     EXPECT_EQ(expanded.topLevel.copies, 0u);
     EXPECT_GT(expanded.topLevel.bytes, 0u);
     EXPECT_FALSE(walked.topLevel.built);
+}
+
+// The expansion cache's budget starts at UnrollCache::kStartBytes, or where the options say
+// (at most their limit), and where it starts changes what is expanded, never a pixel.
+TEST(Render, TheExpansionBudgetStartsWhereToldAndChangesNoPixel) {
+    EXPECT_EQ(RenderOptions{}.expansionStartBytes, UnrollCache::kStartBytes);
+    auto c = compile(testing::sierpinski(8));  // (whose expansions need no growth)
+    ASSERT_TRUE(c->graph);
+    RenderOptions o = small(2);
+    o.expansionBytes = 4u << 20;
+    const RenderResult start = render(*c->graph, o);
+    o.expansionStartBytes = 4u << 20;
+    const RenderResult full = render(*c->graph, o);
+    o.expansionStartBytes = 64u << 20;  // (more than the limit: the limit)
+    const RenderResult over = render(*c->graph, o);
+    EXPECT_EQ(start.expansionBudget, UnrollCache::kStartBytes);
+    EXPECT_EQ(full.expansionBudget, size_t{4} << 20);
+    EXPECT_EQ(over.expansionBudget, size_t{4} << 20);
+    EXPECT_GT(full.expansions, 0u);
+    EXPECT_TRUE(sameBytes(start, full)) << differingPixels(start, full) << " pixels differ";
+    EXPECT_TRUE(sameBytes(full, over)) << differingPixels(full, over) << " pixels differ";
 }
 
 }  // namespace

@@ -192,7 +192,7 @@ Tracer::~Tracer() = default;
 
 UnrollCache& TraceScene::expansionCache() const {
     std::call_once(expansionOnce_, [this] {
-        expansionCache_ = std::make_unique<UnrollCache>(*this, expansionBytes);
+        expansionCache_ = std::make_unique<UnrollCache>(*this, expansionBytes, expansionStartBytes);
     });
     return *expansionCache_;
 }

@@ -114,6 +114,10 @@ class TraceScene {
     // Expanded instances (unrolled_instances.h): one cache shared by all the tracers of
     // this scene (unroll_cache.h) holds at most this many bytes; 0 turns them off.
     size_t expansionBytes = 16u << 20;
+    // Where that cache's budget starts (it grows toward expansionBytes where a larger one
+    // saves expansions, unroll_cache.h); at expansionBytes, every expansion that fits it
+    // is kept from the start.
+    size_t expansionStartBytes = size_t{2} << 20;  // (UnrollCache::kStartBytes)
     // That cache, made by the first tracer that asks for it (with expansionBytes then).
     UnrollCache& expansionCache() const;
     // The budget that cache reached (it starts small and grows, unroll_cache.h); 0 if

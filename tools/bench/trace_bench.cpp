@@ -40,11 +40,13 @@ struct Figures {
     yardstick::Passes passes;
     // Instances expanded in the build render, and again in a timed pass (their median).
     uint64_t buildExpansions = 0, traceExpansions = 0;
+    size_t expansionBudgetBytes = 0;  // the budget the expansion cache reached
     uint64_t peakRssBytes = 0;
 };
 
 struct Options : yardstick::TraceOptions {
     size_t expansionCacheMb = 16;  // pcsg render's --expansion-cache-mb
+    size_t expansionStartMb = 2;   // where its budget starts, as pcsg render's
 };
 
 void print(const Options& o, const Figures& f) {
@@ -56,6 +58,8 @@ void print(const Options& o, const Figures& f) {
         j["build_expansions"] = f.buildExpansions;
         j["trace_expansions"] = f.traceExpansions;
         j["expansion_cache_mb"] = o.expansionCacheMb;
+        j["expansion_start_mb"] = o.expansionStartMb;
+        j["expansion_budget_bytes"] = f.expansionBudgetBytes;
         std::cout << j.dump(2) << "\n";
         return;
     }
@@ -63,10 +67,11 @@ void print(const Options& o, const Figures& f) {
         "scene:           {}\nimage:           {}x{}, {} threads\n"
         "compile time:    {:.3f} s\nbuild time:      {:.3f} s ({} instances expanded)\n"
         "trace time:      {:.3f} s, the median of {} passes ({} instances expanded again "
-        "each)\nrays:            {}\nrays/s:          {:.0f}\npeak RSS:        {:.1f} MB\n",
+        "each)\nrays:            {}\nrays/s:          {:.0f}\nexpansion cache: {:.1f} MB "
+        "budget reached\npeak RSS:        {:.1f} MB\n",
         o.scene, o.width, o.height, o.threads, f.compileSeconds, f.buildSeconds, f.buildExpansions,
         f.passes.median(), o.passes, f.traceExpansions, f.passes.rays, f.passes.raysPerSecond(),
-        f.peakRssBytes / 1e6);
+        f.expansionBudgetBytes / 1e6, f.peakRssBytes / 1e6);
 }
 
 // The build render and the timed passes over the image's pixel centres.
@@ -74,6 +79,7 @@ void traceTimed(const Graph& g, const Options& o, Figures& f) {
     tracer::RenderOptions ro;
     ro.width = o.width, ro.height = o.height, ro.threads = o.threads;
     ro.expansionBytes = o.expansionCacheMb << 20;
+    ro.expansionStartBytes = o.expansionStartMb << 20;
     const tracer::Region image{0, 0, o.width, o.height};
     const tracer::RowSink discard = [](int, std::span<const float>) {};
     Clock::time_point start = Clock::now();
@@ -93,6 +99,7 @@ void traceTimed(const Graph& g, const Options& o, Figures& f) {
         before = after;
     }
     f.traceExpansions = static_cast<uint64_t>(tools::median(expansions));
+    f.expansionBudgetBytes = before.expansionBudget;
 }
 
 int run(const Options& o) {
@@ -127,6 +134,13 @@ int main(int argc, char** argv) {
     app.add_option("--expansion-cache-mb", o.expansionCacheMb,
                    "Memory limit in MB of the cache of expanded sub-graph instances, as for pcsg "
                    "render (0: none)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
+    app.add_option("--expansion-start-mb", o.expansionStartMb,
+                   "Where that cache's budget starts, in MB (at most --expansion-cache-mb), as for "
+                   "pcsg render; it grows toward the limit where a larger one saves expansions. At "
+                   "the limit, every expansion that fits is kept from the first ray: with a large "
+                   "limit, the rate of pcsg's expanded representation held whole")
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     if (const int status = pcsg::yardstick::parse(app, argc, argv); status >= 0) return status;
