@@ -7,8 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "bounds.h"
 #include "test_support.h"
@@ -309,6 +311,38 @@ TEST(TopLevel, CopiesReferToTheCachesInstanceWhichLivesOnWithTheTopLevel) {
         EXPECT_EQ(after[i].key, before[i].key) << "ray " << i;
     }
     EXPECT_GT(hits, 300u);
+}
+
+// A tracer that finds no top level and then takes the lock after another has built and
+// published one returns that one and does not build another: building again freed the
+// published top level while other tracers traced it (a rare crash of frame sequences on
+// two threads).
+TEST(TopLevel, ATopLevelPublishedBeforeTheLockIsNotBuiltAgain) {
+    auto c = compile(testing::sierpinski(5));
+    ASSERT_TRUE(c->graph);
+    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
+    scene.expansionBytes = 256u << 10;  // (the cache expands a level below the top)
+    std::vector<Vec3> o, d;
+    fan(17, 2000, o, d);
+    scene.twoLevel = false;  // (the warm-up's tracer builds none)
+    Tracer warm(scene);
+    SurfaceHit h;
+    for (int round = 0; round < 2; ++round)
+        for (size_t i = 0; i < o.size(); ++i) warm.firstHit(o[i], d[i], 1e-4, 1e7, h);
+    scene.twoLevel = true;
+    ASSERT_EQ(scene.topLevel(), nullptr);
+    const TopLevel* other = nullptr;
+    bool first = true;
+    scene.beforeTopLock = [&] {  // another tracer builds it, between this one's look and lock
+        if (!std::exchange(first, false)) return;
+        other = scene.buildTopLevel();
+    };
+    const TopLevel* mine = scene.buildTopLevel();
+    ASSERT_TRUE(other);
+    EXPECT_EQ(mine, other);
+    EXPECT_EQ(scene.topLevel(), other);
+    const std::vector<Hit> hits = hitsOf(*other, o, d);  // (ASan: a use after free if freed)
+    EXPECT_TRUE(std::any_of(hits.begin(), hits.end(), [](const Hit& x) { return x.valid; }));
 }
 
 // Shadow rays through the copies and their shared instance (which stop at their first

@@ -204,8 +204,14 @@ size_t TraceScene::expansionBudget() const {
 const TopLevel* TraceScene::buildTopLevel(uint32_t maxTries) const {
     if (const TopLevel* t = topLevel()) return t;
     if (!useBounds || !instanceBoxes_ || expansionBytes == 0 || !twoLevel) return nullptr;
+    if (beforeTopLock) beforeTopLock();
     const std::unique_lock lock(topMutex_, std::try_to_lock);
-    if (!lock.owns_lock() || topTries_ >= maxTries) return nullptr;
+    if (!lock.owns_lock()) return nullptr;
+    // Again under the lock: another tracer may have built it between the look above and
+    // the lock, and building it again would free the one published, which other tracers
+    // may be tracing (a rare crash in frame sequences: a ray in the freed top level).
+    if (const TopLevel* t = topLevel()) return t;
+    if (topTries_ >= maxTries) return nullptr;
     ++topTries_;
     bool manyCopies = false;
     try {

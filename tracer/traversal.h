@@ -48,6 +48,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -125,7 +126,7 @@ class TraceScene {
     size_t expansionBudget() const;
 
     // Each tracer remembers the results of C- and T-steps (compiler/step_memo.h) in a table
-    // of at most 2^stepMemoLog2 entries (it starts within 256 KB and grows while it misses
+    // of at most 2^stepMemoLog2 entries (it starts within 128 KB and grows while it misses
     // often); 0 turns it off.
     uint32_t stepMemoLog2 = 12;
 
@@ -142,6 +143,9 @@ class TraceScene {
     // already; returns it (nullptr: refused or not built). The tracers call it once the
     // cache has seen enough rays to know where it expands; tests call it directly.
     const TopLevel* buildTopLevel(uint32_t maxTries = 4) const;
+    // Tests: called by buildTopLevel between its first look for a built top level and its
+    // lock, where another tracer may build and publish one.
+    std::function<void()> beforeTopLock;
 
     // What entering each node means (with the fused chains of constant T-nodes).
     const Semantics& semantics() const { return sem_; }
