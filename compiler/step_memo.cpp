@@ -136,11 +136,12 @@ namespace {
 
 // The most bytes a thread's table starts with: 2^entriesLog2 entries, halved until they
 // fit. A Sierpinski tetrahedron's 32-byte entries keep their 4,096 (128 KB); the growing
-// tree's 240-byte ones (a T-node's two matrices) get 1,024, not 4,096 (0.98 MB a thread, in
-// every frame of a sequence): its 48 frames at 640x480 on two threads 18.3 -> 16.7 MB of
-// peak RSS (docs/benchmarks.md, branch static). It hits for nearly all its steps, so its
-// table never grows (StepMemoGrowth).
-constexpr size_t kStartTableBytes = size_t{256} << 10;
+// tree's 240-byte ones (a T-node's two matrices) get 512 (123 KB a thread, in every frame
+// of a sequence), where it misses for none of its steps, so that its table never grows
+// (StepMemoGrowth). At 4,096 its 48 frames at 640x480 on two threads took 18.3 MB of peak
+// RSS, at 1,024 16.7 MB (docs/benchmarks.md, branch static), and 512 saves 0.15 MB more
+// (the median of eight runs; "The terrain's ceiling"). Tables that miss more grow.
+constexpr size_t kStartTableBytes = size_t{128} << 10;
 
 uint32_t entriesLog2Within(size_t stride, uint32_t entriesLog2, size_t maxBytes) {
     while (entriesLog2 > 0 && (stride * sizeof(uint64_t) << entriesLog2) > maxBytes) --entriesLog2;

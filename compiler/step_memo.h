@@ -66,9 +66,9 @@ struct StepMemoGrowth {
 
 // Per thread: the table (a few thousand entries). An entry holds as many read and written
 // values as the plan's nodes need at most (a Sierpinski tetrahedron's one slot: 32 bytes,
-// where room for kMaxReads and kMaxWrites took 336). The table starts within 256 KB and
+// where room for kMaxReads and kMaxWrites took 336). The table starts within 128 KB and
 // grows towards 2^entriesLog2 entries while it misses often (StepMemoGrowth): the terrain's
-// 304-byte entries start at 512, where the rays missed for 48% of their steps.
+// 304-byte entries start at 256 and grow while its rays miss for many of their steps.
 class StepMemo {
   public:
     StepMemo(const Graph& g, const StepMemoPlan& plan, uint32_t entriesLog2 = 12,

@@ -292,11 +292,11 @@ S if(c > 0, 2, 1)
     EXPECT_EQ(full.maxWrites(), 24u);
     EXPECT_GE(full.maxReads(), 2u);
     EXPECT_LT(full.maxReads(), StepMemoPlan::kMaxReads);
-    // Its entries are over 200 bytes: 1,024 of them (a table of at most 256 KB), not 4,096.
+    // Its entries are over 200 bytes: 512 of them (a table of at most 128 KB), not 4,096.
     const size_t entryBytes = (2 + full.maxReads() + full.maxWrites()) * sizeof(uint64_t);
     const StepMemo large(*k->graph, full, 12);
-    EXPECT_EQ(large.bytes(), 1024u * entryBytes);
-    EXPECT_EQ(StepMemo(*k->graph, full, 9).bytes(), 512u * entryBytes);
+    EXPECT_EQ(large.bytes(), 512u * entryBytes);
+    EXPECT_EQ(StepMemo(*k->graph, full, 8).bytes(), 256u * entryBytes);
 }
 
 // A table that misses for most of its lookups doubles at the end of each window, up to
@@ -309,7 +309,7 @@ TEST(StepMemo, ATableThatMissesOftenGrowsUpToItsLimit) {
     StepMemoGrowth growth;
     growth.window = 1024;
     StepMemo memo(*c->graph, plan, 12, growth);
-    EXPECT_EQ(memo.bytes(), 1024u * entryBytes);         // the start: within 256 KB
+    EXPECT_EQ(memo.bytes(), 512u * entryBytes);          // the start: within 128 KB
     checkAgainstDirect(*c->graph, memo, 400, 1u << 20);  // nearly every key new
     EXPECT_EQ(memo.bytes(), 4096u * entryBytes);
 
@@ -328,7 +328,7 @@ TEST(StepMemo, ATableThatHitsKeepsItsSize) {
     growth.window = 16384;
     StepMemo memo(*c->graph, plan, 12, growth);
     const size_t start = memo.bytes();
-    checkAgainstDirect(*c->graph, memo, 8000);                  // few distinct keys
+    checkAgainstDirect(*c->graph, memo, 8000, 2);               // few distinct keys
     EXPECT_GT(memo.hits() + memo.misses(), 4 * growth.window);  // windows were ended
     EXPECT_EQ(memo.bytes(), start);
 }
