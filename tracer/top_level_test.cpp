@@ -278,6 +278,15 @@ std::vector<Hit> hitsOf(const TopLevel& top, const std::vector<Vec3>& o,
     return hits;
 }
 
+// The rays (o, d) traced twice through the scene, so that its expansion cache expands
+// what they meet twice.
+void warmUp(const TraceScene& scene, const std::vector<Vec3>& o, const std::vector<Vec3>& d) {
+    Tracer warm(scene);
+    SurfaceHit h;
+    for (int round = 0; round < 2; ++round)
+        for (size_t i = 0; i < o.size(); ++i) warm.firstHit(o[i], d[i], 1e-4, 1e7, h);
+}
+
 TEST(TopLevel, CopiesReferToTheCachesInstanceWhichLivesOnWithTheTopLevel) {
     auto c = compile(testing::sierpinski(5));
     ASSERT_TRUE(c->graph);
@@ -286,12 +295,7 @@ TEST(TopLevel, CopiesReferToTheCachesInstanceWhichLivesOnWithTheTopLevel) {
     scene->expansionBytes = 256u << 10;  // (the cache expands a level below the top)
     std::vector<Vec3> o, d;
     fan(5, 2000, o, d);
-    {
-        Tracer warm(*scene);
-        SurfaceHit h;
-        for (int round = 0; round < 2; ++round)
-            for (size_t i = 0; i < o.size(); ++i) warm.firstHit(o[i], d[i], 1e-4, 1e7, h);
-    }
+    warmUp(*scene, o, d);
     const auto one = TopLevel::build(*scene, scene->expansionCache(), scene->expansionBytes);
     const auto two = TopLevel::build(*scene, scene->expansionCache(), scene->expansionBytes);
     ASSERT_TRUE(one && two);
@@ -313,22 +317,31 @@ TEST(TopLevel, CopiesReferToTheCachesInstanceWhichLivesOnWithTheTopLevel) {
     EXPECT_GT(hits, 300u);
 }
 
+// Sierpinski order 5, whose expansion cache expands a level below the top, and the rays
+// (o, d) of a fan through it.
+class TopLevelOfOrder5 : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        c_ = compile(testing::sierpinski(5));
+        ASSERT_TRUE(c_->graph);
+        scene_ = std::make_unique<TraceScene>(*c_->graph, computeBounds(*c_->graph), true,
+                                              eagerExpansion());
+        scene_->expansionBytes = 256u << 10;
+        fan(17, 2000, o, d);
+    }
+    std::unique_ptr<testing::Compiled> c_;
+    std::unique_ptr<TraceScene> scene_;
+    std::vector<Vec3> o, d;
+};
+
 // A tracer that finds no top level and then takes the lock after another has built and
 // published one returns that one and does not build another: building again freed the
 // published top level while other tracers traced it (a rare crash of frame sequences on
 // two threads).
-TEST(TopLevel, ATopLevelPublishedBeforeTheLockIsNotBuiltAgain) {
-    auto c = compile(testing::sierpinski(5));
-    ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
-    scene.expansionBytes = 256u << 10;  // (the cache expands a level below the top)
-    std::vector<Vec3> o, d;
-    fan(17, 2000, o, d);
+TEST_F(TopLevelOfOrder5, APublishedTopLevelIsNotBuiltAgain) {
+    TraceScene& scene = *scene_;
     scene.twoLevel = false;  // (the warm-up's tracer builds none)
-    Tracer warm(scene);
-    SurfaceHit h;
-    for (int round = 0; round < 2; ++round)
-        for (size_t i = 0; i < o.size(); ++i) warm.firstHit(o[i], d[i], 1e-4, 1e7, h);
+    warmUp(scene, o, d);
     scene.twoLevel = true;
     ASSERT_EQ(scene.topLevel(), nullptr);
     const TopLevel* other = nullptr;
@@ -349,17 +362,9 @@ TEST(TopLevel, ATopLevelPublishedBeforeTheLockIsNotBuiltAgain) {
 // surface and leave the hit's key and normal unset): one that ends at the first hit's t
 // meets nothing (a surface at tmax only wins a tie with a hit already found), one that
 // ends a step further meets it, and first hits traced after them are what they were.
-TEST(TopLevel, ShadowRaysThroughCopiesEndAtTheFirstHit) {
-    auto c = compile(testing::sierpinski(5));
-    ASSERT_TRUE(c->graph);
-    TraceScene scene(*c->graph, computeBounds(*c->graph), true, eagerExpansion());
-    scene.expansionBytes = 256u << 10;  // (the cache expands a level below the top)
-    std::vector<Vec3> o, d;
-    fan(17, 2000, o, d);
-    Tracer warm(scene);
-    SurfaceHit h;
-    for (int round = 0; round < 2; ++round)
-        for (size_t i = 0; i < o.size(); ++i) warm.firstHit(o[i], d[i], 1e-4, 1e7, h);
+TEST_F(TopLevelOfOrder5, ShadowRaysThroughCopiesEndAtTheFirstHit) {
+    TraceScene& scene = *scene_;
+    warmUp(scene, o, d);
     const TopLevel* top = scene.buildTopLevel();
     ASSERT_TRUE(top);
     const std::vector<Hit> before = hitsOf(*top, o, d);
