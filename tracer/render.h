@@ -42,6 +42,7 @@
 #include "bounds.h"
 #include "graph.h"
 #include "instance_boxes.h"
+#include "unroll_cache.h"
 
 namespace pcsg::tracer {
 
@@ -70,7 +71,7 @@ struct RenderOptions {
     size_t expansionBytes = 16u << 20;
     // Where that cache's budget starts (at most expansionBytes; the budget grows toward it
     // where a larger one saves expansions).
-    size_t expansionStartBytes = size_t{2} << 20;  // (UnrollCache::kStartBytes)
+    size_t expansionStartBytes = UnrollCache::kStartBytes;
     // Called from worker threads with the fraction done (0..1); may be empty.
     std::function<void(double)> progress;
     // Called from worker threads after each tile of each pass (1, or 2 for adaptive

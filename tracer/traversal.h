@@ -118,7 +118,7 @@ class TraceScene {
     // Where that cache's budget starts (it grows toward expansionBytes where a larger one
     // saves expansions, unroll_cache.h); at expansionBytes, every expansion that fits it
     // is kept from the start.
-    size_t expansionStartBytes = size_t{2} << 20;  // (UnrollCache::kStartBytes)
+    size_t expansionStartBytes = UnrollCache::kStartBytes;
     // That cache, made by the first tracer that asks for it (with expansionBytes then).
     UnrollCache& expansionCache() const;
     // The budget that cache reached (it starts small and grows, unroll_cache.h); 0 if
