@@ -79,13 +79,20 @@ struct PovJob {
     int width = 64, height = 48;
 };
 
-// Renders POV-Ray scenes without anti-aliasing, each in a fresh directory, all at once
-// (POV-Ray spends most of a small render sleeping between its threads' messages, so
-// running them side by side costs little CPU and saves most of the wall time).
-inline std::vector<PovRun> renderPovMany(const std::vector<PovJob>& jobs) {
+// POV-Ray gave up before rendering because its worker threads did not start in time,
+// which happens when the machine is loaded (many renders at once beside sanitizer
+// tests). The scene is not at fault, so such a run is tried again.
+inline bool povThreadsTimedOut(const PovRun& run) {
+    return run.log.find("Timed out waiting for worker thread startup") != std::string::npos;
+}
+
+// Renders POV-Ray scenes without anti-aliasing, each in a fresh directory under `root`,
+// all at once (POV-Ray spends most of a small render sleeping between its threads'
+// messages, so running them side by side costs little CPU and saves most of the wall
+// time).
+inline std::vector<PovRun> renderPovBatch(const std::vector<PovJob>& jobs,
+                                          const std::filesystem::path& root) {
     namespace fs = std::filesystem;
-    const fs::path root =
-        fs::path(::testing::TempDir()) / ("pcsg_pov_" + std::to_string(::getpid()));
     fs::remove_all(root);
     std::string script = "#!/bin/sh\n";
     for (size_t i = 0; i < jobs.size(); ++i) {
@@ -118,6 +125,19 @@ inline std::vector<PovRun> renderPovMany(const std::vector<PovJob>& jobs) {
         r.rgb = readPpm((dir / "out.ppm").string(), r.width, r.height);
     }
     fs::remove_all(root);
+    return runs;
+}
+
+// renderPovBatch, with the runs whose threads timed out tried again (one at a time, up
+// to `retries` times each), so that a loaded machine does not fail a test. A run that
+// still times out is returned as it is, and fails its test.
+inline std::vector<PovRun> renderPovMany(const std::vector<PovJob>& jobs, int retries = 3) {
+    const std::filesystem::path root =
+        std::filesystem::path(::testing::TempDir()) / ("pcsg_pov_" + std::to_string(::getpid()));
+    std::vector<PovRun> runs = renderPovBatch(jobs, root);
+    for (size_t i = 0; i < runs.size(); ++i)
+        for (int attempt = 0; attempt < retries && povThreadsTimedOut(runs[i]); ++attempt)
+            runs[i] = renderPovBatch({jobs[i]}, root).front();
     return runs;
 }
 
