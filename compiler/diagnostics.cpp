@@ -105,6 +105,20 @@ void appendQuote(std::string& out, std::string_view line, uint32_t column) {
 
 }  // namespace
 
+std::vector<uint32_t> lineStartsOf(std::string_view text) {
+    std::vector<uint32_t> starts{0};
+    const char* base = text.data();
+    const char* p = base;
+    const char* end = base + text.size();
+    while (p < end) {
+        const void* nl = std::memchr(p, '\n', static_cast<size_t>(end - p));
+        if (!nl) break;
+        p = static_cast<const char*>(nl) + 1;
+        starts.push_back(static_cast<uint32_t>(p - base));
+    }
+    return starts;
+}
+
 std::string Diagnostics::format() const {
     std::string out;
     // Line starts of each file, computed once and only for files with errors.
@@ -119,18 +133,7 @@ std::string Diagnostics::format() const {
         out += fmt::format("{}:{}:{}: error: {}\n", name, d.loc.line, d.loc.column, d.message);
         const std::string_view text = texts_[d.loc.file];
         auto& starts = lineStarts[d.loc.file];
-        if (starts.empty()) {
-            starts.push_back(0);
-            const char* base = text.data();
-            const char* p = base;
-            const char* end = base + text.size();
-            while (p < end) {
-                const void* nl = std::memchr(p, '\n', static_cast<size_t>(end - p));
-                if (!nl) break;
-                p = static_cast<const char*>(nl) + 1;
-                starts.push_back(static_cast<uint32_t>(p - base));
-            }
-        }
+        if (starts.empty()) starts = lineStartsOf(text);
         if (d.loc.line > starts.size()) continue;
         const size_t begin = starts[d.loc.line - 1];
         size_t end = d.loc.line < starts.size() ? starts[d.loc.line] - 1 : text.size();

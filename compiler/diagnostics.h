@@ -13,6 +13,9 @@
 
 namespace pcsg {
 
+// The byte offset at which each line of `text` starts (the first line's, 0, included).
+std::vector<uint32_t> lineStartsOf(std::string_view text);
+
 struct Diagnostic {
     FileLoc loc;
     std::string message;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "diagnostics.h"
 
@@ -77,6 +78,15 @@ TEST(DiagnosticsFormat, HugeMessagesAreCut) {
     ASSERT_EQ(d.errors().size(), 1u);
     EXPECT_LE(d.errors()[0].message.size(), 410u);
     EXPECT_EQ(d.errors()[0].message.substr(d.errors()[0].message.size() - 3), "...");
+}
+
+// Line starts, which both the lexer's locations and the quoted lines come from: every byte
+// after a '\n' starts a line, the first line starts at 0, and a '\r' stays in its line.
+TEST(DiagnosticsFormat, LineStartsFollowEveryNewline) {
+    EXPECT_EQ(lineStartsOf(""), (std::vector<uint32_t>{0}));
+    EXPECT_EQ(lineStartsOf("a"), (std::vector<uint32_t>{0}));
+    EXPECT_EQ(lineStartsOf("a\n"), (std::vector<uint32_t>{0, 2}));
+    EXPECT_EQ(lineStartsOf("a\nb\r\n\nc"), (std::vector<uint32_t>{0, 2, 5, 6}));
 }
 
 }  // namespace

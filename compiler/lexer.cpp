@@ -14,18 +14,8 @@ namespace pcsg {
 // ---------------------------------------------------------------------------------------
 // Source
 
-Source::Source(std::string_view text, uint32_t file) : text_(text), file_(file) {
-    lineStarts_.push_back(0);
-    const char* base = text.data();
-    const char* p = base;
-    const char* end = base + text.size();
-    while (p < end) {
-        const void* nl = std::memchr(p, '\n', static_cast<size_t>(end - p));
-        if (!nl) break;
-        p = static_cast<const char*>(nl) + 1;
-        lineStarts_.push_back(static_cast<uint32_t>(p - base));
-    }
-}
+Source::Source(std::string_view text, uint32_t file)
+    : text_(text), file_(file), lineStarts_(lineStartsOf(text)) {}
 
 FileLoc Source::loc(uint32_t offset) const {
     // The last line start <= offset.
