@@ -1,9 +1,12 @@
 // pcsg fmt: the canonical layout of a scene. See formatter.h.
 #include "formatter.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <initializer_list>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "ast.h"
@@ -66,14 +69,92 @@ struct Item {
     std::string text;
 };
 
+// The macro uses of a file as the printer sees them (lexer.h's MacroOrigins): the tokens
+// each use expanded into, so that a construct made of exactly one use's tokens is printed
+// as the macro's name. Every use must be printed so, once; what is left over is a use
+// whose expansion is not a whole construct, which pcsg fmt cannot keep (unclaimed()).
+class MacroUses {
+  public:
+    MacroUses(const Source& src, const std::vector<Token>& t, const MacroOrigins& o)
+        : src_(src),
+          t_(t),
+          o_(o),
+          first_(o.uses.size(), kNone),
+          last_(o.uses.size(), kNone),
+          claimed_(o.uses.size(), false) {
+        for (uint32_t i = 0; i < o.useOf.size() && i < t.size(); ++i) {
+            const uint32_t u = o.useOf[i];
+            if (u == kNone) continue;
+            if (first_[u] == kNone) first_[u] = i;
+            last_[u] = i;
+        }
+    }
+
+    // The use whose expansion is exactly the tokens [from, to], or that with the
+    // parentheses around them, claimed: its name. Else nullopt.
+    std::optional<std::string> whole(uint32_t from, uint32_t to) const {
+        if (std::optional<uint32_t> u = exactly(from, to)) return claim(*u);
+        if (from == 0 || to + 1 >= t_.size() || t_[from - 1].kind != Tok::LParen ||
+            t_[to + 1].kind != Tok::RParen)
+            return std::nullopt;
+        if (std::optional<uint32_t> u = exactly(from - 1, to + 1)) return claim(*u);
+        return std::nullopt;
+    }
+    // Where a token begins and ends in the file (a token of a use: where the use does).
+    uint32_t begin(uint32_t tok) const {
+        const uint32_t u = useOf(tok);
+        return u == kNone ? t_[tok].offset : o_.uses[u].begin;
+    }
+    uint32_t end(uint32_t tok) const {
+        const uint32_t u = useOf(tok);
+        return u == kNone ? t_[tok].offset + t_[tok].length : o_.uses[u].end;
+    }
+    // A use not printed as its name (or that expands to nothing), if any.
+    std::optional<uint32_t> unclaimed() const {
+        for (uint32_t u = 0; u < claimed_.size(); ++u)
+            if (!claimed_[u]) return u;
+        return std::nullopt;
+    }
+    std::string name(uint32_t u) const {
+        const MacroOrigins::Range r = o_.uses[u];
+        return std::string(src_.text().substr(r.begin, r.end - r.begin));
+    }
+    uint32_t offset(uint32_t u) const { return o_.uses[u].begin; }
+
+  private:
+    static constexpr uint32_t kNone = MacroOrigins::kNone;
+    uint32_t useOf(uint32_t tok) const { return tok < o_.useOf.size() ? o_.useOf[tok] : kNone; }
+    // The use whose expansion is the tokens [from, to], if any.
+    std::optional<uint32_t> exactly(uint32_t from, uint32_t to) const {
+        const uint32_t u = useOf(from);
+        if (u == kNone || first_[u] != from || last_[u] != to) return std::nullopt;
+        return u;
+    }
+    std::string claim(uint32_t u) const {
+        claimed_[u] = true;
+        return name(u);
+    }
+
+    const Source& src_;
+    const std::vector<Token>& t_;
+    const MacroOrigins& o_;
+    std::vector<uint32_t> first_, last_;  // per use: its first and last token
+    mutable std::vector<bool> claimed_;
+};
+
 constexpr char kIndentMore = '\x02';  // a new line, indented one step more than the `{`'s
 constexpr char kIndentSame = '\x03';  // a new line, indented as the `{`'s
 
 class Printer {
   public:
     Printer(const Source& src, const std::vector<Token>& tokens, const Ast& ast,
-            const BraceComments& braceComments)
-        : src_(src), t_(tokens), ast_(ast), braceComments_(braceComments) {}
+            const BraceComments& braceComments, const MacroUses& uses)
+        : src_(src),
+          t_(tokens),
+          ast_(ast),
+          braceComments_(braceComments),
+          uses_(uses),
+          match_(matchParens(tokens)) {}
 
     // One statement, possibly over several lines, without a final newline.
     std::string statement(const Stmt& s) const {
@@ -82,7 +163,10 @@ class Printer {
     }
 
   private:
-    std::string text(uint32_t tok) const { return std::string(spelling(src_, t_[tok])); }
+    std::string text(uint32_t tok) const {
+        if (std::optional<std::string> use = uses_.whole(tok, tok)) return *use;
+        return std::string(spelling(src_, t_[tok]));
+    }
 
     // --- arithmetic ---
 
@@ -102,6 +186,10 @@ class Printer {
 
     std::string expr(uint32_t e) const {
         const ExNode& n = ast_.exprs[e];
+        if (std::optional<std::string> use = uses_.whole(n.from, n.to)) return *use;
+        // (in parentheses the printer puts back where they are needed)
+        if (t_[n.from].kind == Tok::LParen && n.to > n.from + 1)
+            if (std::optional<std::string> use = uses_.whole(n.from + 1, n.to - 1)) return *use;
         switch (n.kind) {
             case ExKind::Number:
             case ExKind::Name:
@@ -169,7 +257,54 @@ class Printer {
         return std::string(src_.text().substr(c.begin, c.end - c.begin));
     }
 
-    uint32_t endOf(uint32_t tok) const { return t_[tok].offset + t_[tok].length; }
+    uint32_t endOf(uint32_t tok) const { return uses_.end(tok); }
+    uint32_t beginOf(uint32_t tok) const { return uses_.begin(tok); }
+
+    // A CSG term's first and last token: parentheses around it not included, those
+    // around its parts included.
+    uint32_t firstTok(uint32_t c) const {
+        const CsgNode& n = ast_.csg[c];
+        if (n.kind == CsgKind::Operator) return wrapped(ast_.lists[n.first]).first;
+        return n.kind == CsgKind::Name || n.kind == CsgKind::Call ? n.nameTok : n.tok;
+    }
+    uint32_t lastTok(uint32_t c) const {
+        const CsgNode& n = ast_.csg[c];
+        switch (n.kind) {
+            case CsgKind::Operator:
+                return wrapped(ast_.lists[n.first + n.count - 1]).second;
+            case CsgKind::Transform:
+            case CsgKind::Calc:
+            case CsgKind::Paint:
+                return wrapped(n.child).second;
+            case CsgKind::Name:
+                return n.nameTok;
+            case CsgKind::Primitive:
+            case CsgKind::Call: {
+                const uint32_t head = n.kind == CsgKind::Call ? n.nameTok : n.tok;
+                if (head + 1 >= t_.size() || t_[head + 1].kind != Tok::LParen) return head;
+                return match_[head + 1];
+            }
+        }
+        return n.tok;
+    }
+    // A term's tokens with the parentheses around it.
+    std::pair<uint32_t, uint32_t> wrapped(uint32_t c) const {
+        uint32_t a = firstTok(c), b = lastTok(c);
+        while (a > 0 && t_[a - 1].kind == Tok::LParen && match_[a - 1] == b + 1) --a, ++b;
+        return {a, b};
+    }
+    // The matching parenthesis of each '(' and ')' (else kNoNode).
+    static std::vector<uint32_t> matchParens(const std::vector<Token>& t) {
+        std::vector<uint32_t> match(t.size(), kNoNode), open;
+        for (uint32_t i = 0; i < t.size(); ++i) {
+            if (t[i].kind == Tok::LParen) open.push_back(i);
+            if (t[i].kind != Tok::RParen || open.empty()) continue;
+            match[i] = open.back();
+            match[open.back()] = i;
+            open.pop_back();
+        }
+        return match;
+    }
 
     // The lines of a braced list with comments: each item on a line of its own, a comment
     // after an item on its line, other comments on lines of their own before the next
@@ -199,7 +334,7 @@ class Printer {
         std::vector<Item> items;
         for (uint32_t k = 0; k < n.count; ++k) {
             const Assign& a = ast_.assigns[n.first + k];
-            items.push_back({{t_[a.nameTok].offset, endOf(ast_.exprs[a.value].to)},
+            items.push_back({{beginOf(a.nameTok), endOf(ast_.exprs[a.value].to)},
                              cat({text(a.nameTok), " = ", expr(a.value)})});
         }
         std::string s = "{";
@@ -210,6 +345,11 @@ class Printer {
 
     std::string calc(uint32_t c) const {
         const CsgNode& n = ast_.csg[c];
+        // A macro whose body is the C-node's block (the paper's figure 8)
+        uint32_t close = wrapped(n.child).first - 1;
+        while (close > n.tok && t_[close].kind == Tok::Newline) --close;
+        if (std::optional<std::string> use = uses_.whole(n.tok, close))
+            return cat({*use, " ", child(n.child)});
         if (auto it = braceComments_.find(n.tok); it != braceComments_.end())
             return calcLines(n, it->second);
         std::string s = "{";
@@ -223,6 +363,7 @@ class Printer {
 
     std::string csg(uint32_t c) const {
         const CsgNode& n = ast_.csg[c];
+        if (std::optional<std::string> use = uses_.whole(firstTok(c), lastTok(c))) return *use;
         switch (n.kind) {
             case CsgKind::Operator:
                 return operatorCsg(n);
@@ -367,7 +508,7 @@ class Printer {
         for (uint32_t k = 0; !atoms && k < s.count; ++k) {
             const DirectiveItem& item = ast_.items[s.first + k];
             if (item.flag) {
-                list.push_back({{t_[item.nameTok].offset, endOf(item.nameTok)},
+                list.push_back({{beginOf(item.nameTok), endOf(item.nameTok)},
                                 std::string(text(item.nameTok))});
                 continue;
             }
@@ -378,7 +519,7 @@ class Printer {
                 last = &ast_.items[s.first + ++k];
                 line += cat({", ", value(*last)});
             }
-            list.push_back({{t_[item.nameTok].offset, endOf(lastToken(*last))}, line});
+            list.push_back({{beginOf(item.nameTok), endOf(lastToken(*last))}, line});
         }
         uint32_t open = s.tok;
         while (t_[open].kind != Tok::LBrace) ++open;
@@ -401,7 +542,7 @@ class Printer {
             const uint32_t from = k++;
             while (k < s.first + s.count && ast_.atoms[k].kind != AtomKind::Word) ++k;
             const Atom &a = ast_.atoms[from], &b = ast_.atoms[k - 1];
-            list.push_back({{t_[a.tok].offset, endOf(b.end)}, atoms(from, k)});
+            list.push_back({{beginOf(a.tok), endOf(b.end)}, atoms(from, k)});
         }
         return list;
     }
@@ -456,39 +597,45 @@ class Printer {
     const std::vector<Token>& t_;
     const Ast& ast_;
     const BraceComments& braceComments_;
+    const MacroUses& uses_;
+    const std::vector<uint32_t> match_;
 };
 
-// The comments of a text, in order, and the offset of a `#` outside them (or none).
-struct Scan {
+// The comments of a text, in order.
+std::vector<Span> scanComments(std::string_view s) {
     std::vector<Span> comments;
-    std::optional<uint32_t> hash;
-};
-
-Scan scanComments(std::string_view s) {
-    Scan scan;
     size_t i = s.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
     while (i < s.size()) {
         if (s[i] == '/' && i + 1 < s.size() && (s[i + 1] == '/' || s[i + 1] == '*')) {
             const bool line = s[i + 1] == '/';
             size_t end = line ? s.find('\n', i) : s.find("*/", i + 2);
             end = end == std::string_view::npos ? s.size() : end + (line ? 0 : 2);
-            scan.comments.push_back({static_cast<uint32_t>(i), static_cast<uint32_t>(end)});
+            comments.push_back({static_cast<uint32_t>(i), static_cast<uint32_t>(end)});
             i = end;
             continue;
         }
-        if (s[i] == '#' && !scan.hash) scan.hash = static_cast<uint32_t>(i);
         ++i;
     }
-    return scan;
+    return comments;
+}
+
+// The comments inside #defines, which are printed as written, marked.
+std::vector<bool> insideDefines(const std::vector<Span>& comments, const MacroOrigins& origins) {
+    std::vector<bool> inside(comments.size(), false);
+    for (const MacroOrigins::Range& d : origins.defines)
+        for (size_t k = 0; k < comments.size(); ++k)
+            if (comments[k].begin >= d.begin && comments[k].begin < d.end) inside[k] = true;
+    return inside;
 }
 
 // The comments inside braces (C-nodes and directives); `used` marks them.
-BraceComments braceComments(const std::vector<Token>& t, const std::vector<Span>& comments,
-                            std::vector<bool>& used) {
+BraceComments braceComments(const std::vector<Token>& t, const MacroOrigins& origins,
+                            const std::vector<Span>& comments, std::vector<bool>& used) {
     BraceComments result;
     if (comments.empty()) return result;
     for (uint32_t i = 0; i < t.size(); ++i) {
         if (t[i].kind != Tok::LBrace) continue;
+        if (i < origins.useOf.size() && origins.useOf[i] != MacroOrigins::kNone) continue;
         size_t j = i + 1;
         for (int depth = 1; depth > 0 && t[j].kind != Tok::End; ++j)
             depth += t[j].kind == Tok::LBrace ? 1 : t[j].kind == Tok::RBrace ? -1 : 0;
@@ -505,7 +652,8 @@ BraceComments braceComments(const std::vector<Token>& t, const std::vector<Span>
 }
 
 // Each statement's text: its first token to its last.
-std::vector<Span> statementSpans(const Ast& ast, const std::vector<Token>& t) {
+std::vector<Span> statementSpans(const Ast& ast, const std::vector<Token>& t,
+                                 const MacroUses& uses) {
     std::vector<Span> spans;
     for (const Stmt& s : ast.stmts) {
         size_t j = s.tok;
@@ -513,8 +661,7 @@ std::vector<Span> statementSpans(const Ast& ast, const std::vector<Token>& t) {
                !((t[j].kind == Tok::Newline || t[j].kind == Tok::Semicolon) &&
                  (t[j].flags & kTopLevel)))
             ++j;
-        const Token& last = t[j - 1];
-        spans.push_back({t[s.tok].offset, last.offset + last.length});
+        spans.push_back({uses.begin(s.tok), uses.end(static_cast<uint32_t>(j - 1))});
     }
     return spans;
 }
@@ -582,6 +729,55 @@ class Emitter {
     uint32_t last_ = 0;
 };
 
+// The items of a file in their order: its statements (k < stmts) and its #defines.
+struct Order {
+    std::vector<Span> spans;        // statements first, then the #defines
+    std::vector<uint32_t> byBegin;  // indices into spans, in the file's order
+};
+
+Order fileOrder(std::vector<Span> statements, const MacroOrigins& origins) {
+    Order order{std::move(statements), {}};
+    for (const MacroOrigins::Range& d : origins.defines) order.spans.push_back({d.begin, d.end});
+    for (uint32_t k = 0; k < order.spans.size(); ++k) order.byBegin.push_back(k);
+    std::sort(order.byBegin.begin(), order.byBegin.end(),
+              [&](uint32_t a, uint32_t b) { return order.spans[a].begin < order.spans[b].begin; });
+    return order;
+}
+
+// A #define as written, without the spaces at the ends of its lines.
+std::string defineText(std::string_view text, Span d) {
+    std::string out;
+    std::string_view rest = text.substr(d.begin, d.end - d.begin);
+    for (;;) {
+        const size_t nl = rest.find('\n');
+        out += rtrim(rest.substr(0, nl));
+        if (nl == std::string_view::npos) return out;
+        out += '\n';
+        rest.remove_prefix(nl + 1);
+    }
+}
+
+// Why the file cannot be formatted with its macros kept, if it cannot: a #define inside a
+// statement, or a use of a macro that is not a whole construct (MacroUses).
+bool macrosKept(const Source& src, const Order& order, size_t statements, const MacroUses& uses,
+                Diagnostics& diags) {
+    for (size_t k = 1; k < order.byBegin.size(); ++k) {
+        const Span a = order.spans[order.byBegin[k - 1]], b = order.spans[order.byBegin[k]];
+        if (b.begin >= a.end) continue;
+        const Span d = order.byBegin[k] >= statements ? b : a;
+        diags.error(src.loc(d.begin), "pcsg fmt cannot format a #define inside a statement");
+        return false;
+    }
+    if (const std::optional<uint32_t> u = uses.unclaimed()) {
+        diags.error(src.loc(uses.offset(*u)),
+                    fmt::format("pcsg fmt cannot keep this use of macro '{}': its body is not a "
+                                "whole C-node block, expression or CSG term here",
+                                uses.name(*u)));
+        return false;
+    }
+    return true;
+}
+
 }  // namespace
 
 std::optional<std::string> formatScene(std::string_view fileName, std::string_view text,
@@ -589,28 +785,33 @@ std::optional<std::string> formatScene(std::string_view fileName, std::string_vi
     if (!compileSource(fileName, text, diags)) return std::nullopt;
     const uint32_t file = static_cast<uint32_t>(diags.fileNames().size() - 1);
     const Source src(text, file);
-    const Scan scan = scanComments(text);
-    if (scan.hash) {
-        diags.error(src.loc(*scan.hash), "pcsg fmt does not format files with #define yet");
-        return std::nullopt;
-    }
+    const std::vector<Span> comments = scanComments(text);
     Diagnostics quiet;  // the file compiled: lexing and parsing it again report nothing
-    const TokenStream tokens = lex(src, quiet);
+    MacroOrigins origins;
+    const TokenStream tokens = lex(src, quiet, &origins);
     const Ast ast = parse(src, tokens, quiet);
-    std::vector<bool> used(scan.comments.size(), false);
-    const BraceComments inBraces = braceComments(tokens.tokens, scan.comments, used);
+    const MacroUses uses(src, tokens.tokens, origins);
+    std::vector<bool> used = insideDefines(comments, origins);
+    const BraceComments inBraces = braceComments(tokens.tokens, origins, comments, used);
     std::vector<Span> others;
-    for (size_t k = 0; k < scan.comments.size(); ++k)
-        if (!used[k]) others.push_back(scan.comments[k]);
-    const Printer printer(src, tokens.tokens, ast, inBraces);
-    const std::vector<Span> spans = statementSpans(ast, tokens.tokens);
-    const Placement place = placeComments(text, spans, others);
+    for (size_t k = 0; k < comments.size(); ++k)
+        if (!used[k]) others.push_back(comments[k]);
+    const Printer printer(src, tokens.tokens, ast, inBraces, uses);
+    std::vector<std::string> bodies;
+    for (const Stmt& stmt : ast.stmts) bodies.push_back(printer.statement(stmt));
+    const Order order = fileOrder(statementSpans(ast, tokens.tokens, uses), origins);
+    if (!macrosKept(src, order, ast.stmts.size(), uses, diags)) return std::nullopt;
+    std::vector<Span> sorted;
+    for (uint32_t k : order.byBegin) sorted.push_back(order.spans[k]);
+    const Placement place = placeComments(text, sorted, others);
     Emitter out(text);
     size_t ci = 0;
-    for (size_t k = 0; k < ast.stmts.size(); ++k) {
-        while (ci < place.standalone.size() && place.standalone[ci].begin < spans[k].begin)
+    for (size_t i = 0; i < sorted.size(); ++i) {
+        while (ci < place.standalone.size() && place.standalone[ci].begin < sorted[i].begin)
             out.comment(place.standalone[ci++]);
-        out.statement(spans[k], printer.statement(ast.stmts[k]), place.inner[k], place.trailing[k]);
+        const uint32_t k = order.byBegin[i];
+        const std::string body = k < bodies.size() ? bodies[k] : defineText(text, sorted[i]);
+        out.statement(sorted[i], body, place.inner[i], place.trailing[i]);
     }
     while (ci < place.standalone.size()) out.comment(place.standalone[ci++]);
     return out.take();
@@ -618,7 +819,9 @@ std::optional<std::string> formatScene(std::string_view fileName, std::string_vi
 
 std::string printSyntaxTree(const Source& src, const std::vector<Token>& tokens, const Ast& ast) {
     const BraceComments none;
-    const Printer printer(src, tokens, ast, none);
+    const MacroOrigins noMacros;
+    const MacroUses uses(src, tokens, noMacros);
+    const Printer printer(src, tokens, ast, none, uses);
     std::string out;
     for (const Stmt& s : ast.stmts) out += printer.statement(s) + "\n";
     return out;

@@ -16,8 +16,13 @@
 // line of its own just before that statement. One blank line is kept where the text had one or
 // more.
 //
-// A file that uses #define is refused (the lexer expands macros before the parser, so
-// the tree no longer shows them): "pcsg fmt does not format files with #define yet".
+// Macros: the lexer expands them before the parser, so the tree shows their bodies. The
+// lexer says where each token came from (MacroOrigins), and a construct made of exactly
+// one use's tokens (a C-node's block, as in the paper's figure 8, an expression, a CSG
+// term, a single token) is printed as the macro's name; each #define is printed as
+// written, in its place. A use that is only part of a construct (`#define PART
+// move(1,0,0)` in `PART sphere`), one that expands to nothing, and a #define inside a
+// statement cannot be kept so: the file is refused, with the place.
 #pragma once
 
 #include <optional>
@@ -34,7 +39,7 @@ inline constexpr size_t kFormatWidth = 100;
 inline constexpr size_t kFormatIndent = 4;
 
 // The canonical text of a scene, or nothing with the errors in `diags` when the scene
-// does not compile (or uses #define). `text` must outlive `diags`.
+// does not compile, or has a macro that cannot be kept (above). `text` must outlive `diags`.
 std::optional<std::string> formatScene(std::string_view fileName, std::string_view text,
                                        Diagnostics& diags);
 

@@ -528,9 +528,27 @@ void applyNewlineRule(const std::vector<Token>& in, std::vector<Token>& out) {
     }
 }
 
+// The uses of the tokens after the newline rule, from those before it (`useOf`): the rule
+// only inserts Newline tokens, and one between two tokens of the same use is that use's.
+std::vector<uint32_t> usesAfterNewlines(const std::vector<Token>& out,
+                                        const std::vector<uint32_t>& useOf) {
+    std::vector<uint32_t> after;
+    after.reserve(out.size());
+    size_t j = 0;  // the next token before the rule
+    for (const Token& t : out) {
+        if (t.kind != Tok::Newline) {
+            after.push_back(useOf[j++]);
+            continue;
+        }
+        const bool inside = j > 0 && j < useOf.size() && useOf[j - 1] == useOf[j];
+        after.push_back(inside ? useOf[j] : MacroOrigins::kNone);
+    }
+    return after;
+}
+
 }  // namespace
 
-TokenStream lex(const Source& src, Diagnostics& diags) {
+TokenStream lex(const Source& src, Diagnostics& diags, MacroOrigins* origins) {
     // Fresh memory is the main cost of lexing a large file, so every stage reserves what
     // it may need once (untouched reserved pages cost nothing) and is freed when done.
     std::vector<Token> raw;
@@ -549,12 +567,14 @@ TokenStream lex(const Source& src, Diagnostics& diags) {
         std::any_of(raw.begin(), raw.end(), [](const Token& t) { return t.kind == Tok::Hash; });
     std::vector<Token> afterMacros;
     if (hasDirectives) {
-        ts.complete = expandMacros(src, diags, raw, afterMacros) && ts.complete;
+        ts.complete = expandMacros(src, diags, raw, afterMacros, origins) && ts.complete;
         std::vector<Token>().swap(raw);
     } else {
         afterMacros.swap(raw);
+        if (origins) origins->useOf.assign(afterMacros.size(), MacroOrigins::kNone);
     }
     applyNewlineRule(afterMacros, ts.tokens);
+    if (origins) origins->useOf = usesAfterNewlines(ts.tokens, origins->useOf);
     return ts;
 }
 

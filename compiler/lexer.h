@@ -169,9 +169,24 @@ struct TokenStream {
     bool complete = true;
 };
 
+// Where the macros of a file went, for pcsg fmt, which prints each use of a macro as its
+// name and each #define as written: the #define lines and blocks, every use of a macro
+// outside them (a use inside another macro's body is part of that macro's expansion),
+// and for each token of the stream the use it came from.
+struct MacroOrigins {
+    static constexpr uint32_t kNone = UINT32_MAX;
+    struct Range {
+        uint32_t begin, end;  // source offsets
+    };
+    std::vector<Range> defines;   // from the '#' to the end of the body's last token
+    std::vector<Range> uses;      // the macro's name where it is used
+    std::vector<uint32_t> useOf;  // per token of the stream: an index in uses, or kNone
+};
+
 // Lexes `src` and expands its macros. Errors go to `diags`; the stream is usable (ends
-// with End) even then, so that the parser can report more errors.
-TokenStream lex(const Source& src, Diagnostics& diags);
+// with End) even then, so that the parser can report more errors. With `origins`, also
+// says where the macros went.
+TokenStream lex(const Source& src, Diagnostics& diags, MacroOrigins* origins = nullptr);
 
 // The keyword of a primitive (the Kw values of the primitives follow PrimitiveKind).
 constexpr Kw primitiveKeyword(PrimitiveKind k) {

@@ -58,6 +58,32 @@ std::string errors(const std::string& text) {
     return out;
 }
 
+// Where macros went (for pcsg fmt): the #define lines and blocks, each use outside them,
+// and for each token the use it came from; a use inside a macro's body belongs to the
+// outer use, and a line break the newline rule puts inside a block belongs to its use.
+TEST(Lexer, MacroOriginsSayWhichUseEachTokenCameFrom) {
+    const std::string text = "#define B {\n  a = 1\n  b = 2\n}\n#define C B sphere\nC | B cube\n";
+    Diagnostics diags;
+    const Source src(text, diags.addFile("t.pcsg", text));
+    MacroOrigins o;
+    const TokenStream ts = lex(src, diags, &o);
+    ASSERT_FALSE(diags.hasErrors()) << diags.format();
+    ASSERT_EQ(o.defines.size(), 2u);
+    EXPECT_EQ(text.substr(o.defines[0].begin, o.defines[0].end - o.defines[0].begin),
+              "#define B {\n  a = 1\n  b = 2\n}");
+    EXPECT_EQ(text.substr(o.defines[1].begin, o.defines[1].end - o.defines[1].begin),
+              "#define C B sphere");
+    ASSERT_EQ(o.uses.size(), 2u);
+    EXPECT_EQ(text.substr(o.uses[0].begin, 1), "C");
+    EXPECT_EQ(text.substr(o.uses[1].begin, 1), "B");
+    ASSERT_EQ(o.useOf.size(), ts.tokens.size());
+    std::string uses;  // each token's use: 0, 1 or '-' for none
+    for (size_t k = 0; k < ts.tokens.size(); ++k)
+        uses += o.useOf[k] == MacroOrigins::kNone ? '-' : static_cast<char>('0' + o.useOf[k]);
+    // C: { a = 1 nl b = 2 nl } sphere; then |; B: { a = 1 nl b = 2 nl }; then cube, EOF
+    EXPECT_EQ(uses, "00000000000-1111111111--");
+}
+
 TEST(Lexer, UnicodeAndAsciiOperatorsAreTheSameTokens) {
     EXPECT_EQ(kinds("A ∪ B ∩ C \\ D → E"), kinds("A | B & C \\ D -> E"));
     EXPECT_EQ(kinds("A | B"), (std::vector<Tok>{Tok::Ident, Tok::Union, Tok::Ident, Tok::End}));

@@ -14,8 +14,8 @@ namespace {
 class MacroProcessor {
   public:
     MacroProcessor(const Source& src, Diagnostics& diags, const std::vector<Token>& raw,
-                   std::vector<Token>& out)
-        : src_(src), diags_(diags), raw_(raw), out_(out) {}
+                   std::vector<Token>& out, MacroOrigins* origins)
+        : src_(src), diags_(diags), raw_(raw), out_(out), origins_(origins) {}
 
     void run() {
         collect();
@@ -29,14 +29,18 @@ class MacroProcessor {
                 continue;
             }
             if (macroAt_[i] != kNotMacro) {
+                if (origins_) origins_->uses.push_back({t.offset, t.offset + t.length});
                 use(macroAt_[i], t, t.flags & kLineStart);
+                if (origins_) origins_->useOf.resize(out_.size(), origins_->uses.size() - 1);
                 ++i;
                 continue;
             }
             emit(t);
+            if (origins_) origins_->useOf.resize(out_.size(), MacroOrigins::kNone);
             ++i;
         }
         out_.push_back(raw_.back());
+        if (origins_) origins_->useOf.push_back(MacroOrigins::kNone);
     }
 
     bool stopped() const { return stop_; }
@@ -125,6 +129,10 @@ class MacroProcessor {
             return raw_.size() - 1;
         }
         define(i, nameTok, b);
+        if (origins_) {
+            const Token& last = raw_[std::max(b.end, i + 3) - 1];
+            origins_->defines.push_back({raw_[i].offset, last.offset + last.length});
+        }
         return b.next;
     }
 
@@ -294,6 +302,7 @@ class MacroProcessor {
     Diagnostics& diags_;
     const std::vector<Token>& raw_;
     std::vector<Token>& out_;
+    MacroOrigins* origins_;
     std::vector<Macro> macros_;
     std::unordered_map<std::string_view, uint32_t> byName_;
     static constexpr uint32_t kNotMacro = UINT32_MAX;
@@ -306,8 +315,8 @@ class MacroProcessor {
 }  // namespace
 
 bool expandMacros(const Source& src, Diagnostics& diags, const std::vector<Token>& raw,
-                  std::vector<Token>& out) {
-    MacroProcessor macros(src, diags, raw, out);
+                  std::vector<Token>& out, MacroOrigins* origins) {
+    MacroProcessor macros(src, diags, raw, out, origins);
     macros.run();
     return !macros.stopped();
 }

@@ -14,7 +14,9 @@ namespace pcsg {
 // the other tokens to `out` with every macro use replaced by its body, and the End.
 // Returns false when it stopped early (an unclosed block, too many tokens): `out` is
 // then only a prefix of the file.
+// With `origins`, its defines, its uses and its useOf (one entry per token of `out`) are
+// filled too.
 bool expandMacros(const Source& src, Diagnostics& diags, const std::vector<Token>& raw,
-                  std::vector<Token>& out);
+                  std::vector<Token>& out, MacroOrigins* origins = nullptr);
 
 }  // namespace pcsg

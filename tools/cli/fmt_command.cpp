@@ -95,8 +95,10 @@ void addFmtCommand(CLI::App& app, int& status) {
         "line; "
         "elsewhere inside a "
         "statement moved to the line before it). A scene that "
-        "does not compile gets its errors and exit status 1, and nothing is written. Files "
-        "with #define are refused: \"pcsg fmt does not format files with #define yet\".");
+        "does not compile gets its errors and exit status 1, and nothing is written. Macros "
+        "are kept: each #define as written, each use as the macro's name where its body is a "
+        "whole C-node block, expression or CSG term (else the file is refused, with the "
+        "place).");
     cmd->add_option("scene", o->scene, "The .pcsg file (- reads standard input, without -i)")
         ->required();
     cmd->add_flag("-i,--in-place", o->inPlace,

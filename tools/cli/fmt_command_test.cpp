@@ -51,15 +51,20 @@ TEST(FmtCommand, ACompileErrorExitsOneAndWritesNothing) {
     EXPECT_EQ(testing::filesIn(dir.path()), std::vector<std::string>{"bad.pcsg"});
 }
 
-TEST(FmtCommand, AFileWithDefineIsRefused) {
+// A file with #define is formatted with its macros kept; one whose macro cannot be kept is
+// refused, and left as it was.
+TEST(FmtCommand, AFileWithDefineKeepsItsMacrosOrIsLeftAlone) {
     TempDir dir;
-    const std::string text = "#define BALL sphere\nBALL\n";
-    const std::string scene = dir.write("m.pcsg", text);
+    const std::string scene = dir.write("m.pcsg", "#define BALL sphere\nBALL  |  cube\n");
     const ChildResult r = pcsg({"fmt", scene, "-i"});
-    EXPECT_EQ(r.exitCode, 1);
-    EXPECT_NE(r.err.find("pcsg fmt does not format files with #define yet"), std::string::npos)
-        << r.err;
-    EXPECT_EQ(readFile(scene), text);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(readFile(scene), "#define BALL sphere\nBALL ∪ cube\n");
+    const std::string part = "#define PART move(1,0,0)\nPART sphere\n";
+    const std::string partial = dir.write("p.pcsg", part);
+    const ChildResult p = pcsg({"fmt", partial, "-i"});
+    EXPECT_EQ(p.exitCode, 1);
+    EXPECT_NE(p.err.find("cannot keep this use of macro 'PART'"), std::string::npos) << p.err;
+    EXPECT_EQ(readFile(partial), part);
 }
 
 // The formatted scene renders the same image, byte for byte.
