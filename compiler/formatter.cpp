@@ -619,6 +619,22 @@ std::vector<Span> scanComments(std::string_view s) {
     return comments;
 }
 
+// Whether no comment holds one of the control characters that mark the printer's breaks
+// and indents (kBreak ... kBreakCalc); reports the first that does.
+bool plainComments(const Source& src, const std::vector<Span>& comments, Diagnostics& diags) {
+    for (const Span& c : comments) {
+        const std::string_view body = src.text().substr(c.begin, c.end - c.begin);
+        const size_t at = body.find_first_of("\x01\x02\x03\x04");
+        if (at == std::string_view::npos) continue;
+        diags.error(src.loc(c.begin + static_cast<uint32_t>(at)),
+                    fmt::format("pcsg fmt cannot format a comment with the control character "
+                                "0x{:02x}",
+                                static_cast<int>(body[at])));
+        return false;
+    }
+    return true;
+}
+
 // The comments inside #defines, which are printed as written, marked.
 std::vector<bool> insideDefines(const std::vector<Span>& comments, const MacroOrigins& origins) {
     std::vector<bool> inside(comments.size(), false);
@@ -786,6 +802,7 @@ std::optional<std::string> formatScene(std::string_view fileName, std::string_vi
     const uint32_t file = static_cast<uint32_t>(diags.fileNames().size() - 1);
     const Source src(text, file);
     const std::vector<Span> comments = scanComments(text);
+    if (!plainComments(src, comments, diags)) return std::nullopt;
     Diagnostics quiet;  // the file compiled: lexing and parsing it again report nothing
     MacroOrigins origins;
     const TokenStream tokens = lex(src, quiet, &origins);

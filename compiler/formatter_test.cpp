@@ -150,6 +150,21 @@ TEST(Formatter, AMacroThatIsNotAWholeConstructIsRefused) {
         << diags.format();
 }
 
+// The printer marks breaks and indents with the control characters 0x01 to 0x04, so a
+// comment that holds one is refused rather than broken apart (found by the parser's
+// libFuzzer target, which formats every scene that compiles).
+TEST(Formatter, ACommentWithAMarkerCharacterIsRefused) {
+    const std::string text = "{n = 1 // a \x01 b\n  k = 2} sphere\n";
+    Diagnostics diags;
+    EXPECT_FALSE(formatScene("c.pcsg", text, diags));
+    EXPECT_NE(diags.format().find("c.pcsg:1:13: error: pcsg fmt cannot format a comment with the "
+                                  "control character 0x01"),
+              std::string::npos)
+        << diags.format();
+    EXPECT_EQ(format("{n = 1 // a \x05 b\n  k = 2} sphere\n"),
+              "{\n    n = 1 // a \x05 b\n    k = 2\n} sphere\n");
+}
+
 TEST(Formatter, CommentsSurvive) {
     const std::string text =
         "// header\n"

@@ -13,16 +13,20 @@
 //
 // Besides "never crash, hang or exhaust the stack", every graph that compiles must be
 // well formed: indices inside their arrays, and expression code whose stack never goes
-// deeper than the maxStack it declares (the evaluator sizes its stack from it).
+// deeper than the maxStack it declares (the evaluator sizes its stack from it). And pcsg
+// fmt of a scene that compiles gives a text that compiles and that it leaves unchanged.
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
 #include "compiler.h"
 #include "eval.h"
 #include "fast_code.h"
+#include "formatter.h"
 
 namespace {
 
@@ -90,6 +94,21 @@ void checkGraph(const Graph& g) {
     }
 }
 
+// pcsg fmt of a scene that compiles: either a clear error (a macro it cannot keep), or a
+// text that compiles too and that it prints again unchanged.
+void checkFormatted(std::string_view text) {
+    Diagnostics diags;
+    const std::optional<std::string> once = formatScene("fuzz.pcsg", text, diags);
+    if (!once) {
+        check(diags.hasErrors(), "pcsg fmt refused without an error");
+        return;
+    }
+    Diagnostics again;
+    check(compileSource("fmt.pcsg", *once, again).has_value(), "pcsg fmt's text does not compile");
+    const std::optional<std::string> twice = formatScene("fmt.pcsg", *once, again);
+    check(twice && *twice == *once, "pcsg fmt is not idempotent");
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -100,6 +119,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (graph) {
         check(!diags.hasErrors(), "a graph despite errors");
         checkGraph(*graph);
+        checkFormatted(text);
     } else {
         check(diags.hasErrors() && !printed.empty(), "no graph and no error");
         check(diags.errors().size() <= Diagnostics::kMaxErrors, "too many errors");
