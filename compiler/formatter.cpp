@@ -100,6 +100,8 @@ class MacroUses {
         if (std::optional<uint32_t> u = exactly(from - 1, to + 1)) return claim(*u);
         return std::nullopt;
     }
+    // Whether the tokens [from, to] are exactly one use's (not claimed).
+    bool covers(uint32_t from, uint32_t to) const { return exactly(from, to).has_value(); }
     // Where a token begins and ends in the file (a token of a use: where the use does).
     uint32_t begin(uint32_t tok) const {
         const uint32_t u = useOf(tok);
@@ -172,7 +174,17 @@ class Printer {
 
     int exprLevel(uint32_t e) const {
         const ExNode& n = ast_.exprs[e];
+        if (parenthesizedUse(n.from, n.to)) return kAtom;  // (`#define SUM (1+2)`: SUM * 4)
         return n.kind == ExKind::Chain ? level(ast_.chainItems[n.first].op) : kAtom;
+    }
+    // Whether the tokens [from, to] are one macro use's whole body, in parentheses of its
+    // own: the use needs no more around it.
+    bool parenthesizedUse(uint32_t from, uint32_t to) const {
+        return t_[from].kind == Tok::LParen && match_[from] == to && uses_.covers(from, to);
+    }
+    bool parenthesizedUse(uint32_t c) const {
+        const auto [from, to] = wrapped(c);
+        return parenthesizedUse(from, to);
     }
 
     std::string list(uint32_t first, uint32_t count) const {
@@ -242,7 +254,7 @@ class Printer {
                     wrap = k > 0 || o.csgOp == CsgOp::Union || o.csgOp == n.csgOp;
             }
             if (k > 0) s += sep;
-            s += wrap ? paren(csg(c)) : csg(c);
+            s += wrap && !parenthesizedUse(c) ? paren(csg(c)) : csg(c);
         }
         return s;
     }
@@ -250,7 +262,7 @@ class Printer {
     // The operand of a prefix: an operator needs its parentheses back.
     std::string child(uint32_t c) const {
         const std::string s = csg(c);
-        return ast_.csg[c].kind == CsgKind::Operator ? paren(s) : s;
+        return ast_.csg[c].kind == CsgKind::Operator && !parenthesizedUse(c) ? paren(s) : s;
     }
 
     std::string comment(Span c) const {

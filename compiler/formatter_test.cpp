@@ -96,25 +96,28 @@ TEST(Formatter, AMacroOfACNodeBlockIsKeptAsWritten) {
 
 // Macros of a number, an expression and a CSG term: each use is a whole construct,
 // printed as the name, with the parentheses the printer puts back where the expansion
-// needs them (`HALF * 2` would join HALF's `/` into one chain).
+// needs them (`HALF * 2` would join HALF's `/` into one chain), and none around a macro
+// whose body brings its own (SUM, PAIR).
 TEST(Formatter, MacrosOfNumbersExpressionsAndTermsKeepTheirNames) {
     const std::string text =
         "#define N 3\n"
         "#define HALF 1/2\n"
         "#define SUM (1+2)\n"
         "#define LEAF move(1,0,0)   sphere\n"
+        "#define PAIR (sphere | cube)\n"
         "{n=N; k=(HALF)*2; m = SUM*4} S\n"
         "S if(n>0,2,1)\n"
-        "1: S -> LEAF | cube\n"
+        "1: S -> LEAF | move(1,0,0) PAIR\n"
         "2: S -> {n=n-1} uscale(HALF) S\n";
     const std::string expected =
         "#define N 3\n"
         "#define HALF 1/2\n"
         "#define SUM (1+2)\n"
         "#define LEAF move(1,0,0)   sphere\n"
-        "{n = N; k = (HALF) * 2; m = (SUM) * 4} S\n"
+        "#define PAIR (sphere | cube)\n"
+        "{n = N; k = (HALF) * 2; m = SUM * 4} S\n"
         "S if(n > 0, 2, 1)\n"
-        "1: S -> LEAF ∪ cube\n"
+        "1: S -> LEAF ∪ move(1, 0, 0) PAIR\n"
         "2: S -> {n = n - 1} uscale(HALF) S\n";
     expectFormatted(text, expected);
 }
