@@ -1,8 +1,10 @@
-// pcsg fmt FILE [-i]: print a scene in its canonical layout (compiler/formatter.h), on
-// standard output or, with -i, in place (a temporary file beside it, then a rename).
+// pcsg fmt FILE [-i | --check]: print a scene in its canonical layout (compiler/formatter.h),
+// on standard output or, with -i, in place (a temporary file beside it, then a rename); or,
+// with --check, only say whether it is in that layout already.
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -11,6 +13,7 @@
 #include <iostream>
 #include <iterator>
 #include <memory>
+#include <string_view>
 
 #include "commands.h"
 #include "formatter.h"
@@ -22,7 +25,21 @@ namespace {
 struct FmtOptions {
     std::string scene;
     bool inPlace = false;
+    bool check = false;
 };
+
+// The exit status of --check for a file that formatting would change.
+constexpr int kNotFormatted = 3;
+
+// The first line (1-based) where two texts differ.
+size_t firstDifferentLine(std::string_view a, std::string_view b) {
+    const size_t n = std::min(a.size(), b.size());
+    size_t at = 0;
+    while (at < n && a[at] == b[at]) ++at;
+    return static_cast<size_t>(
+               std::count(a.begin(), a.begin() + static_cast<ptrdiff_t>(at), '\n')) +
+           1;
+}
 
 // Replaces `path` by `text` atomically: a temporary file in the same directory, with the
 // original's permissions, renamed over it.
@@ -70,6 +87,13 @@ int runFmt(const FmtOptions& o) {
         std::cerr << diags.format() << std::flush;
         return 1;
     }
+    if (o.check) {
+        if (*out == text) return 0;
+        std::cerr << fmt::format("{}:{}: not in pcsg fmt's layout from this line on\n",
+                                 o.scene == "-" ? "<stdin>" : o.scene,
+                                 firstDifferentLine(text, *out));
+        return kNotFormatted;
+    }
     if (!o.inPlace) {
         std::cout << *out << std::flush;
         return 0;
@@ -103,9 +127,15 @@ void addFmtCommand(CLI::App& app, int& status) {
         ->required();
     cmd->add_flag("-i,--in-place", o->inPlace,
                   "Rewrite the file in place (atomically: a temporary file, then a rename)");
+    cmd->add_flag("--check", o->check,
+                  "Write nothing: exit status 0 when the scene is in its canonical layout "
+                  "already, 3 when pcsg fmt would change it (the first line that would change "
+                  "goes to standard error), 1 when it does not compile");
     cmd->callback([o, &status] {
         if (o->inPlace && o->scene == "-")
             throw CLI::ValidationError("-i", "cannot rewrite standard input in place");
+        if (o->inPlace && o->check)
+            throw CLI::ValidationError("--check", "writes nothing: it cannot go with -i");
         status = runFmt(*o);
     });
 }

@@ -1,5 +1,6 @@
 // `pcsg fmt` run as a program: standard output, -i in place (atomically, nothing left
-// behind), compile errors and #define files leave the file alone, bad command lines.
+// behind), --check, compile errors and macros it cannot keep leave the file alone, bad
+// command lines.
 #include <gtest/gtest.h>
 
 #include "cli_test_util.h"
@@ -25,6 +26,34 @@ TEST(FmtCommand, PrintsTheCanonicalLayoutAndLeavesTheFileAlone) {
     EXPECT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(r.out, kCanonical);
     EXPECT_EQ(readFile(scene), kMessy);
+}
+
+// --check writes nothing and says by its exit status whether the file is canonical: 0
+// yes, 3 no (with the first line that would change), 1 when it does not compile.
+TEST(FmtCommand, CheckSaysWhetherTheFileIsCanonicalAndWritesNothing) {
+    TempDir dir;
+    const std::string canonical = dir.write("c.pcsg", kCanonical);
+    const ChildResult ok = pcsg({"fmt", canonical, "--check"});
+    EXPECT_EQ(ok.exitCode, 0) << ok.err;
+    EXPECT_EQ(ok.out + ok.err, "");
+    const std::string messy = dir.write("m.pcsg", kMessy);
+    const ChildResult bad = pcsg({"fmt", messy, "--check"});
+    EXPECT_EQ(bad.exitCode, 3);
+    EXPECT_EQ(bad.out, "");
+    EXPECT_EQ(bad.err, messy + ":1: not in pcsg fmt's layout from this line on\n");
+    EXPECT_EQ(readFile(messy), kMessy);
+    // (the first two lines canonical, the third not)
+    const std::string third = dir.write("t.pcsg",
+                                        "{c = 2} S // axiom\nS if(c > 0, 2, 1)\n1: S->sphere\n"
+                                        "2: S -> {c = c - 1} (S ∪ move(1, 0, 0) S)\n");
+    EXPECT_EQ(pcsg({"fmt", third, "--check"}).err,
+              third + ":3: not in pcsg fmt's layout from this line on\n");
+    const std::string broken = dir.write("b.pcsg", "S ->\n");
+    EXPECT_EQ(pcsg({"fmt", broken, "--check"}).exitCode, 1);
+    EXPECT_EQ(pcsg({"fmt", messy, "--check", "-i"}).exitCode, 2);  // (a bad command line)
+    EXPECT_EQ(readFile(messy), kMessy);
+    EXPECT_EQ(testing::filesIn(dir.path()),
+              (std::vector<std::string>{"b.pcsg", "c.pcsg", "m.pcsg", "t.pcsg"}));
 }
 
 TEST(FmtCommand, InPlaceRewritesTheFileAndLeavesNothingBehind) {
