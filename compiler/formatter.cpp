@@ -757,20 +757,13 @@ class Emitter {
     uint32_t last_ = 0;
 };
 
-// The items of a file in their order: its statements (k < stmts) and its #defines.
-struct Order {
-    std::vector<Span> spans;        // statements first, then the #defines
-    std::vector<uint32_t> byBegin;  // indices into spans, in the file's order
+// What the file is printed as: each statement and each #define, with its text, in the
+// file's order.
+struct Piece {
+    Span span;
+    std::string text;
+    bool define = false;
 };
-
-Order fileOrder(std::vector<Span> statements, const MacroOrigins& origins) {
-    Order order{std::move(statements), {}};
-    for (const MacroOrigins::Range& d : origins.defines) order.spans.push_back({d.begin, d.end});
-    for (uint32_t k = 0; k < order.spans.size(); ++k) order.byBegin.push_back(k);
-    std::sort(order.byBegin.begin(), order.byBegin.end(),
-              [&](uint32_t a, uint32_t b) { return order.spans[a].begin < order.spans[b].begin; });
-    return order;
-}
 
 // A #define as written, without the spaces at the ends of its lines.
 std::string defineText(std::string_view text, Span d) {
@@ -787,13 +780,13 @@ std::string defineText(std::string_view text, Span d) {
 
 // Why the file cannot be formatted with its macros kept, if it cannot: a #define inside a
 // statement, or a use of a macro that is not a whole construct (MacroUses).
-bool macrosKept(const Source& src, const Order& order, size_t statements, const MacroUses& uses,
+bool macrosKept(const Source& src, const std::vector<Piece>& pieces, const MacroUses& uses,
                 Diagnostics& diags) {
-    for (size_t k = 1; k < order.byBegin.size(); ++k) {
-        const Span a = order.spans[order.byBegin[k - 1]], b = order.spans[order.byBegin[k]];
-        if (b.begin >= a.end) continue;
-        const Span d = order.byBegin[k] >= statements ? b : a;
-        diags.error(src.loc(d.begin), "pcsg fmt cannot format a #define inside a statement");
+    for (size_t k = 1; k < pieces.size(); ++k) {
+        const Piece &a = pieces[k - 1], &b = pieces[k];
+        if (b.span.begin >= a.span.end) continue;
+        diags.error(src.loc((b.define ? b : a).span.begin),
+                    "pcsg fmt cannot format a #define inside a statement");
         return false;
     }
     if (const std::optional<uint32_t> u = uses.unclaimed()) {
@@ -826,21 +819,24 @@ std::optional<std::string> formatScene(std::string_view fileName, std::string_vi
     for (size_t k = 0; k < comments.size(); ++k)
         if (!used[k]) others.push_back(comments[k]);
     const Printer printer(src, tokens.tokens, ast, inBraces, uses);
-    std::vector<std::string> bodies;
-    for (const Stmt& stmt : ast.stmts) bodies.push_back(printer.statement(stmt));
-    const Order order = fileOrder(statementSpans(ast, tokens.tokens, uses), origins);
-    if (!macrosKept(src, order, ast.stmts.size(), uses, diags)) return std::nullopt;
+    const std::vector<Span> spans = statementSpans(ast, tokens.tokens, uses);
+    std::vector<Piece> pieces;
+    for (size_t k = 0; k < ast.stmts.size(); ++k)
+        pieces.push_back({spans[k], printer.statement(ast.stmts[k])});
+    for (const MacroOrigins::Range& d : origins.defines)
+        pieces.push_back({{d.begin, d.end}, defineText(text, {d.begin, d.end}), true});
+    std::stable_sort(pieces.begin(), pieces.end(),
+                     [](const Piece& a, const Piece& b) { return a.span.begin < b.span.begin; });
+    if (!macrosKept(src, pieces, uses, diags)) return std::nullopt;
     std::vector<Span> sorted;
-    for (uint32_t k : order.byBegin) sorted.push_back(order.spans[k]);
+    for (const Piece& p : pieces) sorted.push_back(p.span);
     const Placement place = placeComments(text, sorted, others);
     Emitter out(text);
     size_t ci = 0;
-    for (size_t i = 0; i < sorted.size(); ++i) {
+    for (size_t i = 0; i < pieces.size(); ++i) {
         while (ci < place.standalone.size() && place.standalone[ci].begin < sorted[i].begin)
             out.comment(place.standalone[ci++]);
-        const uint32_t k = order.byBegin[i];
-        const std::string body = k < bodies.size() ? bodies[k] : defineText(text, sorted[i]);
-        out.statement(sorted[i], body, place.inner[i], place.trailing[i]);
+        out.statement(sorted[i], pieces[i].text, place.inner[i], place.trailing[i]);
     }
     while (ci < place.standalone.size()) out.comment(place.standalone[ci++]);
     return out.take();

@@ -33,12 +33,8 @@ constexpr int kNotFormatted = 3;
 
 // The first line (1-based) where two texts differ.
 size_t firstDifferentLine(std::string_view a, std::string_view b) {
-    const size_t n = std::min(a.size(), b.size());
-    size_t at = 0;
-    while (at < n && a[at] == b[at]) ++at;
-    return static_cast<size_t>(
-               std::count(a.begin(), a.begin() + static_cast<ptrdiff_t>(at), '\n')) +
-           1;
+    const auto at = std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first;
+    return static_cast<size_t>(std::count(a.begin(), at, '\n')) + 1;
 }
 
 // Replaces `path` by `text` atomically: a temporary file in the same directory, with the
@@ -80,17 +76,16 @@ int runFmt(const FmtOptions& o) {
         }
         text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
+    const std::string name = o.scene == "-" ? "<stdin>" : o.scene;
     Diagnostics diags;
-    const std::optional<std::string> out =
-        formatScene(o.scene == "-" ? "<stdin>" : o.scene, text, diags);
+    const std::optional<std::string> out = formatScene(name, text, diags);
     if (!out) {
         std::cerr << diags.format() << std::flush;
         return 1;
     }
     if (o.check) {
         if (*out == text) return 0;
-        std::cerr << fmt::format("{}:{}: not in pcsg fmt's layout from this line on\n",
-                                 o.scene == "-" ? "<stdin>" : o.scene,
+        std::cerr << fmt::format("{}:{}: not in pcsg fmt's layout from this line on\n", name,
                                  firstDifferentLine(text, *out));
         return kNotFormatted;
     }
