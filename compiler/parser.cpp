@@ -225,12 +225,32 @@ class Parser {
             return axiomB();
         }
         if (a.kind == Tok::Ident && b.kind == Tok::Assign) return definition();
+        if (isCsgOperator(a.kind)) failLeadingOperator();
         if (a.kind == Tok::Keyword && b.kind == Tok::Assign)
             fail(p_, fmt::format("'{}' is a keyword and cannot name a definition", text(pos())));
         if (a.kind == Tok::Ident && !isCsgOperator(b.kind) && b.kind != Tok::Newline &&
             b.kind != Tok::Semicolon && b.kind != Tok::End)
             return moduleDecl();
         return axiomA();
+    }
+
+    // A statement that starts with a CSG operator: the usual cause is a rule continued on
+    // a line that begins with the operator (as many L-system texts write it), where the
+    // line break before it had ended the statement (section 2).
+    [[noreturn]] void failLeadingOperator() {
+        const std::string op(text(pos()));
+        size_t q = p_;
+        while (q > 0 && t_[q - 1].kind == Tok::Newline) --q;
+        if (q == 0) fail(p_, fmt::format("a statement cannot start with '{}'", op));
+        if (t_[q - 1].kind == Tok::Semicolon)
+            fail(p_, fmt::format("a statement cannot start with '{}': the ';' before it ended the "
+                                 "statement",
+                                 op));
+        const uint32_t line = src_.loc(t_[q - 1].offset).line;
+        fail(p_, fmt::format("a statement cannot start with '{0}': the line break after line {1} "
+                             "ended the statement there; to continue it, end line {1} with '{0}' "
+                             "instead, or put the whole expression in parentheses",
+                             op, line));
     }
 
     bool arrowAhead() const {
