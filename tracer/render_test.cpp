@@ -530,6 +530,40 @@ TEST(Render, TheTerrainsTopLevelOfDeferredCutsChangesNoPixel) {
     EXPECT_FALSE(walked.topLevel.built);
 }
 
+// In a scene with transparency every surface records its interior: the paint node instance
+// that applied its material (transparency.h). Instances with such paint nodes inside are
+// expanded too, each surface keeping the paint node and the choices that lead to it, and
+// give the walk's interiors: a glass union painted as a whole is one interior, the glass of
+// each instance of a rule another. (They had been left to the graph walk: a tree of glass
+// fruit rendered 4 times slower than POV-Ray, now 1.2 times.)
+TEST(Render, ExpandedInstancesGiveTheWalksInteriors) {
+    auto c =
+        compile(R"(camera { location <0, -7, 2.5>  look_at <0, 0, 0.6>  sky <0, 0, 1>  angle 50 }
+light { position <4, -6, 9>  color <1, 1, 1> }
+background <0.3, 0.4, 0.6>
+material glass { pigment { color rgbf <0.8, 1, 0.9, 0.85> } finish { phong 0.6 } interior { ior 1.45 } }
+material amber { pigment { color rgbt <1, 0.7, 0.3, 0.6> } interior { ior 1.2 } }
+material stone { color <0.6, 0.55, 0.5> }
+paint(stone) move(0, 0, -1) plane ∪ {n = 3} S
+S if(n > 0, 2, 1)
+1: S -> paint(glass) (sphere ∪ move(0.6, 0, 0) uscale(0.8) sphere) ∪
+        move(0, 0.3, 0.2) paint(amber) uscale(0.5) sphere
+2: S -> paint(stone) move(0, 0, -0.5) scale(0.1, 0.1, 0.5) cylinder ∪
+        move(-1, 0, 0.4) uscale(0.6) {n = n - 1} S ∪ move(1, 0, 0.4) uscale(0.6) {n = n - 1} S ∪
+        move(0, 0, 1) uscale(0.6) paint(glass) {n = n - 1} S
+)");
+    ASSERT_TRUE(c->graph);
+    RenderOptions o = small(2);
+    o.width = 160;
+    o.height = 120;
+    const RenderResult expanded = render(*c->graph, o);
+    o.expansionBytes = 0;
+    const RenderResult walked = render(*c->graph, o);
+    EXPECT_GT(expanded.expansions, 0u);
+    EXPECT_TRUE(sameBytes(expanded, walked))
+        << differingPixels(expanded, walked) << " pixels differ without the expansions";
+}
+
 // The expansion cache's budget starts at UnrollCache::kStartBytes, or where the options say
 // (at most their limit), and where it starts changes what is expanded, never a pixel.
 TEST(Render, TheExpansionBudgetStartsWhereToldAndChangesNoPixel) {

@@ -94,6 +94,8 @@ T if(n > 0, 2, 1)
 struct Result {
     size_t copies = 0, instances = 0, deferred = 0, hits = 0;
     uint64_t expansionsAfter = 0;  // made while the rays were fired through the top level
+    uint64_t expansions = 0;       // made in all
+    size_t interiors = 0;          // hits whose interior is a paint node's (transparency)
     bool built = false;
 };
 
@@ -143,11 +145,14 @@ Result compareRays(const std::string& text, const std::vector<Vec3>& o, const st
         EXPECT_EQ(ha.path, hb.path) << "ray " << i;
         EXPECT_EQ(ha.material, hb.material) << "ray " << i;
         EXPECT_EQ(ha.painted, hb.painted) << "ray " << i;
+        EXPECT_EQ(ha.interior, hb.interior) << "ray " << i;
+        out.interiors += ha.interior != 0;
         if (ha.painted) {
             EXPECT_EQ(ha.paintPoint, hb.paintPoint) << "ray " << i;
         }
     }
     out.expansionsAfter = b.expansions() - expansionsBefore;
+    out.expansions = b.expansions();
     return out;
 }
 
@@ -165,6 +170,29 @@ Result compareWithGraphWalk(const std::string& text, int n, double spread,
         d.push_back(normalize(target - o.back()));
     }
     return compareRays(text, o, d, expansionBytes, options);
+}
+
+// In a scene with transparency every surface records the paint node instance that applied
+// its material (its interior). The instances below such paint nodes are expanded, and each
+// of their surfaces gives the interior the walk gives: a union painted as a whole one, each
+// path to a paint node its own. (The top level stays the walk's there: its Deferred and
+// Instance nodes do not carry paint nodes.)
+TEST(TopLevel, ATransparentScenesExpandedInstancesGiveTheWalksInteriors) {
+    const Result r = compareWithGraphWalk(R"(
+material glass { pigment { color rgbf <0.8, 1, 0.9, 0.85> } interior { ior 1.45 } }
+material amber { pigment { color rgbt <1, 0.7, 0.3, 0.6> } interior { ior 1.2 } }
+{n = 3} S
+S if(n > 0, 2, 1)
+1: S -> paint(glass) (sphere ∪ move(0.6, 0, 0) uscale(0.8) sphere) ∪
+        move(0, 0.3, 0.2) paint(amber) uscale(0.5) sphere ∪ cube
+2: S -> move(-1, 0, 0.4) uscale(0.6) {n = n - 1} S ∪ move(1, 0, 0.4) uscale(0.6) {n = n - 1} S ∪
+        move(0, 0, 1) uscale(0.6) paint(glass) {n = n - 1} S
+)",
+                                          2000, 1.5);
+    EXPECT_GT(r.expansions, 0u);
+    EXPECT_GT(r.hits, 200u);
+    EXPECT_GT(r.interiors, 100u);
+    EXPECT_FALSE(r.built);
 }
 
 TEST(TopLevel, SierpinskiCopiesShareTheirInstanceAndHitTheWalksSurfaces) {

@@ -315,6 +315,7 @@ void Tracer::resetWalk() {
 bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
     if (g_.axiom == kNone) return false;
     const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
+    if (expansion_) expansion_->scratch().interiors.clear();
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
     Hit hit;
@@ -341,8 +342,15 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     out.normal = hit.normal;
     out.material = hit.material;
     out.path = hit.key;
-    out.painted = hit.paint != 0;
-    if (out.painted) {
+    out.painted = false;
+    out.interior = 0;
+    if (hit.paint & UnrolledInstance::kScratchPaint) {  // painted inside an expansion
+        out.interior =
+            expansion_->scratch().interiors[hit.paint & ~UnrolledInstance::kScratchPaint];
+    } else if (hit.paint != 0) {
+        // (painted: the point is in the paint node's frame, for the material's patterns; a
+        // material that records only its interior has none, here or in an expansion)
+        out.painted = scene_.paintFrames[hit.material] & TraceScene::kPaintPoint;
         out.interior = paintInteriors_[hit.paint - 1];
         const LocalRay& p = paintRays_[hit.paint - 1];
         out.paintPoint = p.o + p.d * hit.t;

@@ -28,6 +28,10 @@ bool isUnion(const UnrolledInstance::Node& n) {
     return n.kind == UnrolledInstance::Kind::Operator && n.op == CsgOp::Union;
 }
 
+// A surface's paint handle while an instance's search runs: node n of the instance, whose
+// interior resolvePaint() finds (the walk's own handles are small numbers).
+constexpr uint32_t kNodePaint = 1u << 30;
+
 // The expansion took more visits than its depth promised, or met a paint node whose
 // pattern needs the node's frame: leave it to the graph walk.
 struct TooLarge {};
@@ -51,6 +55,7 @@ struct BuildArrays {
     std::vector<double> args;
     std::vector<UnrolledInstance::BvhNode> bvh;
     std::vector<UnrolledInstance::Link> links;
+    std::vector<UnrolledInstance::PaintAt> paints;
     // The unroller's indices of the matrices and links (kept, emptied, with their slots).
     FlatIndex matrixIndex, linkIndex;
 
@@ -186,6 +191,7 @@ class Unroller {
         f(b.choices, x.choices_);
         f(b.bvh, x.bvh_);
         f(b.links, x.links_);
+        f(b.paints, x.paints_);
     }
 
     // The thread's BuildArrays lent to the expansion being built (when no other on this
@@ -310,9 +316,8 @@ class Unroller {
         if (kind == NodeKind::Calc) {
             scratch.frame = pushFrame();
         }
-        const Step st = sem_.enter(n, s, scratch);
-        if (kind == NodeKind::Paint && paintFrames_ && scene_.paintFrameOf(st.state.material))
-            throw TooLarge{};
+        Step st = sem_.enter(n, s, scratch);
+        if (kind == NodeKind::Paint && paintFrames_) paintNode(n, st.state);
         if (kind == NodeKind::Select) {
             out_.levels_ = std::max(out_.levels_, st.state.depth - base_);
             choices_.push_back(kRuleBit | st.rule);
@@ -356,7 +361,7 @@ class Unroller {
             if (op == CsgOp::Union) inside.extend(b);
             if (op == CsgOp::Intersection) inside = intersect(inside, b);
         }
-        Node x = emit(Kind::Operator, s.material, pendingBase, edge, inside);
+        Node x = emit(Kind::Operator, s, pendingBase, edge, inside);
         x.op = op;
         x.first = static_cast<uint32_t>(out_.children_.size());
         x.count = static_cast<uint32_t>(kids_.size() - base);
@@ -372,8 +377,8 @@ class Unroller {
         if (kind == PrimitiveKind::Empty) return kNone;
         double args[9] = {};
         const uint32_t argc = sem_.primitiveArgs(n, s, args);
-        Node x = emit(isTriangle(kind) ? Kind::Triangle : Kind::Solid, s.material, pendingBase,
-                      edge, primitiveBox(kind, args));
+        Node x = emit(isTriangle(kind) ? Kind::Triangle : Kind::Solid, s, pendingBase, edge,
+                      primitiveBox(kind, args));
         x.prim = kind;
         x.first = static_cast<uint32_t>(out_.args_.size());
         x.count = argc;
@@ -387,7 +392,7 @@ class Unroller {
     uint32_t buildReference(const UnrolledInstance& x, const PathState& s, size_t pendingBase,
                             const Affine* edge) {
         if (x.empty()) return kNone;
-        Node r = emit(Kind::Instance, s.material, pendingBase, edge, x.box());
+        Node r = emit(Kind::Instance, s, pendingBase, edge, x.box());
         r.first = static_cast<uint32_t>(out_.instances_.size());
         out_.instances_.push_back({&x, s.path});
         out_.nodes_.push_back(r);
@@ -399,7 +404,7 @@ class Unroller {
     uint32_t buildDeferred(NodeId n, const PathState& s, uint32_t depth, const Box& box,
                            const InstanceBoxes::Key& key, size_t pendingBase, const Affine* edge) {
         if (box.isEmpty()) return kNone;
-        Node r = emit(Kind::Deferred, s.material, pendingBase, edge, box);
+        Node r = emit(Kind::Deferred, s, pendingBase, edge, box);
         r.first = static_cast<uint32_t>(out_.deferred_.size());
         const auto frame = static_cast<uint32_t>(out_.deferredFrames_.size());
         out_.deferred_.push_back({n, depth, s.depth, frame, s.path, key});
@@ -410,11 +415,12 @@ class Unroller {
 
     // A node entered through the matrices pending_[pendingBase..], holding `inside` (in
     // its own frame).
-    Node emit(Kind kind, uint32_t material, size_t pendingBase, const Affine* edge,
+    Node emit(Kind kind, const PathState& s, size_t pendingBase, const Affine* edge,
               const Box& inside) {
         Node x{};
         x.kind = kind;
-        x.material = material;
+        x.material = s.material;
+        x.paintAt = s.paint == 0 ? kNone : s.paint - 1;
         x.firstMatrix = static_cast<uint32_t>(out_.matrixRefs_.size());
         x.matrices = static_cast<uint32_t>(pending_.size() - pendingBase);
         out_.matrixRefs_.insert(out_.matrixRefs_.end(), pending_.begin() + pendingBase,
@@ -681,6 +687,18 @@ class Unroller {
         return e.x * e.y + e.y * e.z + e.z * e.x;
     }
 
+    // A paint node: the surfaces below it record its instance where the material needs
+    // only that (transparency's interiors: the node and the choices that lead to it); a
+    // pattern's frame is the graph walk's to record.
+    void paintNode(NodeId n, PathState& s) {
+        s.paint = 0;
+        const uint32_t m = s.material;
+        if (!scene_.paintFrameOf(m)) return;
+        if (scene_.paintFrames[m] != TraceScene::kPaintInterior) throw TooLarge{};
+        out_.paints_.push_back({n, static_cast<uint32_t>(choices_.size())});
+        s.paint = static_cast<uint32_t>(out_.paints_.size());
+    }
+
     void setChoices(Node& x) {
         x.firstChoice = static_cast<uint32_t>(out_.choices_.size());
         x.choices = static_cast<uint32_t>(choices_.size());
@@ -743,7 +761,8 @@ size_t UnrolledInstance::bytes() const {
            matrixRefs_.capacity() * sizeof(uint32_t) + args_.capacity() * sizeof(double) +
            choices_.capacity() * sizeof(uint32_t) + bvh_.capacity() * sizeof(BvhNode) +
            links_.capacity() * sizeof(Link) + instances_.capacity() * sizeof(Reference) +
-           deferred_.capacity() * sizeof(Deferred) + deferredFrames_.capacity() * sizeof(double);
+           deferred_.capacity() * sizeof(Deferred) + deferredFrames_.capacity() * sizeof(double) +
+           paints_.capacity() * sizeof(PaintAt);
 }
 
 std::vector<std::vector<uint32_t>> UnrolledInstance::bvhLeafGroups() const {
@@ -812,6 +831,11 @@ uint64_t UnrolledInstance::digest() const {
     d.add(links_.size());
     for (const Link& l : links_) d.add(l.parent), d.add(l.matrix);
     // (only where there are some: the digests of other expansions stay what they were)
+    if (!paints_.empty()) {
+        d.add(paints_.size());
+        for (const PaintAt& p : paints_) d.add(p.node), d.add(p.prefix);
+        for (const Node& n : nodes_) d.add(n.paintAt);
+    }
     if (!deferred_.empty()) d.add(deferred_.size());
     for (const Deferred& x : deferred_) {
         for (uint32_t v : {x.select, x.depth, x.stateDepth, x.frame}) d.add(v);
@@ -863,7 +887,9 @@ bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
     if (!clipToBox(nodes_[root_].box, r, t0, t1)) return false;
     // (instances referred to need theirs too: no resizing while a link's ray is in use)
     if (s.linked.size() < linkSlots_) s.linked.resize(linkSlots_);
-    return firstAt(root_, r, tmin, tmax, hit, use, anyHit, s);
+    if (!firstAt(root_, r, tmin, tmax, hit, use, anyHit, s)) return false;
+    if (hit.paint & kNodePaint) resolvePaint(hit.paint, use.path, s);
+    return true;
 }
 
 size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
@@ -871,7 +897,36 @@ size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
     if (root_ == kNone) return 0;
     double t0 = tmin, t1 = tmax;
     if (!clipToBox(nodes_[root_].box, r, t0, t1)) return 0;
-    return spansAt(root_, r, tmin, tmax, spans, use, s);
+    const size_t count = spansAt(root_, r, tmin, tmax, spans, use, s);
+    if (!paints_.empty())
+        for (size_t k = spans.size() - count; k < spans.size(); ++k) {
+            if (spans[k].in.paint & kNodePaint) resolvePaint(spans[k].in.paint, use.path, s);
+            if (spans[k].out.paint & kNodePaint) resolvePaint(spans[k].out.paint, use.path, s);
+        }
+    return count;
+}
+
+// The paint handle of a surface of `node`: the caller's where the node inherits its
+// material; else, where a paint node inside the instance recorded its instance, the node
+// itself (kNodePaint, until first() or spans() resolve it with the instance's path).
+uint32_t UnrolledInstance::paintOf(const Node& node, const Use& use) const {
+    if (node.material == kInherit) return use.paint;
+    if (node.paintAt == kNone) return 0;
+    return kNodePaint | static_cast<uint32_t>(&node - nodes_.data());
+}
+
+// A surface's paint handle kNodePaint | n becomes its interior (the paint node and the
+// instance path that reached it, as the graph walk records them), kept in the scratch
+// space till the end of the ray's walk (kScratchPaint).
+void UnrolledInstance::resolvePaint(uint32_t& paint, uint64_t path, Scratch& s) const {
+    const Node& node = nodes_[paint & ~kNodePaint];
+    const PaintAt& at = paints_[node.paintAt];
+    for (uint32_t k = 0; k < at.prefix; ++k) {
+        const uint32_t c = choices_[node.firstChoice + k];
+        path = (c & kRuleBit) ? pathRuleInline(path, c & ~kRuleBit) : pathChildInline(path, c);
+    }
+    s.interiors.push_back(pathChild(path, 0x80000000u | at.node) | 1);
+    paint = kScratchPaint | static_cast<uint32_t>(s.interiors.size() - 1);
 }
 
 // A solid primitive's first boundary after tmin that is nearer than the hit so far (or at
@@ -898,7 +953,7 @@ size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
                   inherit ? use.material : node.material,
                   true,
                   anyHit ? 0 : keyOf(node, use.path),
-                  inherit ? use.paint : 0};
+                  paintOf(node, use)};
         tmax = b->t;
         return true;
     }
@@ -944,7 +999,7 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
     }
     const LocalRay rr = enter(node, r);
     const uint32_t material = node.material == kInherit ? use.material : node.material;
-    const uint32_t paint = node.material == kInherit ? use.paint : 0;
+    const uint32_t paint = paintOf(node, use);
     bool found = false;
     switch (node.kind) {
         case Kind::Solid:
@@ -1143,7 +1198,7 @@ size_t UnrolledInstance::spansAt(uint32_t n, const LocalRay& r, double tmin, dou
             const uint32_t material = node.material == kInherit ? use.material : node.material;
             for (int j = 0; j < k; ++j) {
                 sp[j].in.material = sp[j].out.material = material;
-                sp[j].in.paint = sp[j].out.paint = node.material == kInherit ? use.paint : 0;
+                sp[j].in.paint = sp[j].out.paint = paintOf(node, use);
                 spans.push_back(sp[j]);
             }
             count = static_cast<size_t>(k);
@@ -1199,7 +1254,7 @@ size_t UnrolledInstance::keptBuildBytes() {
         bytes += v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type);
     };
     add(b.nodes), add(b.children), add(b.matrixRefs), add(b.choices);
-    add(b.matrices), add(b.args), add(b.bvh), add(b.links);
+    add(b.matrices), add(b.args), add(b.bvh), add(b.links), add(b.paints);
     b.stacks.each(add);
     return bytes + b.matrixIndex.bytes() + b.linkIndex.bytes();
 }

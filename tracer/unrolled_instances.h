@@ -74,8 +74,17 @@ class UnrolledInstance {
         uint32_t first = 0, count = 0;           // operators: children; primitives: args
         uint32_t firstChoice = 0, choices = 0;   // the path from the S-node (hit sources)
         uint32_t bvh = kNone;                    // unions: the root of their first-hit BVH
+        // Surfaces painted inside the instance, in scenes whose paint nodes record their
+        // instance (transparency's interiors): the paint node, paints_[paintAt] (kNone:
+        // none, or the material is the caller's).
+        uint32_t paintAt = kNone;
         Box box;  // what the node holds, in the frame it is entered from, padded
     };
+
+    // The paint handle of a surface painted inside an expansion (Hit::paint,
+    // Boundary::paint): its interior is Scratch::interiors[paint & ~kScratchPaint], kept
+    // till the end of the ray's walk; the walk's own handles are small numbers.
+    static constexpr uint32_t kScratchPaint = 1u << 31;
 
     // First hits through nested unions: the operands of a union and of the unions nested in
     // it (each operand with the matrices on its way, so the arithmetic stays the same) in a
@@ -105,6 +114,13 @@ class UnrolledInstance {
     // matrices_[matrix] (parent kNone: the chain starts at the union).
     struct Link {
         uint32_t parent, matrix;
+    };
+
+    // A paint node whose instance the surfaces below it record (Node::paintAt): the node,
+    // and how many of a surface's choices lead to it.
+    struct PaintAt {
+        NodeId node;
+        uint32_t prefix;
     };
 
     // A Deferred node's S-node instance: the S-node, its depth (Semantics::selectDepth) and
@@ -140,6 +156,7 @@ class UnrolledInstance {
             LocalRay ray{{}, {}};
         };
         std::vector<Linked> linked;
+        std::vector<uint64_t> interiors;  // of the surfaces painted inside (kScratchPaint)
         uint64_t stamp = 0;
         uint64_t visits = 0;
     };
@@ -232,6 +249,8 @@ class UnrolledInstance {
     LocalRay enter(const Node& node, const LocalRay& r) const;
     Vec3 leave(const Node& node, Vec3 normal) const;
     uint64_t keyOf(const Node& node, uint64_t path) const;
+    uint32_t paintOf(const Node& node, const Use& use) const;
+    void resolvePaint(uint32_t& paint, uint64_t path, Scratch& s) const;
 
     std::vector<Node> nodes_;
     std::vector<uint32_t> children_;
@@ -241,6 +260,7 @@ class UnrolledInstance {
     std::vector<uint32_t> choices_;  // bit 31: a rule of an S-node, else an operand
     std::vector<BvhNode> bvh_;
     std::vector<Link> links_;
+    std::vector<PaintAt> paints_;
     // Instance nodes: the instance and the S-node's instance path (from the root).
     struct Reference {
         const UnrolledInstance* instance;
