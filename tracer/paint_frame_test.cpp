@@ -106,7 +106,9 @@ TEST(PaintFrame, InsideTheRecursionIsEachInstancesOwn) {
             [](const Ray&, const SurfaceHit& h) { EXPECT_NEAR(length(h.paintPoint), 1, 1e-9); },
             &expansions);
         EXPECT_GT(painted, 150);
-        EXPECT_EQ(expansions, 0u);  // the graph walk records the paint frames
+        // Instances with the paint inside are expanded too, each surface keeping the
+        // matrices on the way to its paint node (the graph walk had recorded them alone).
+        EXPECT_TRUE(!useBounds || expansions > 0u);
     }
 }
 

@@ -535,7 +535,7 @@ TEST(Render, TheTerrainsTopLevelOfDeferredCutsChangesNoPixel) {
 // expanded too, each surface keeping the paint node and the choices that lead to it, and
 // give the walk's interiors: a glass union painted as a whole is one interior, the glass of
 // each instance of a rule another. (They had been left to the graph walk: a tree of glass
-// fruit rendered 4 times slower than POV-Ray, now 1.2 times.)
+// fruit rendered 4 times slower than POV-Ray, now 1.4 times.)
 TEST(Render, ExpandedInstancesGiveTheWalksInteriors) {
     auto c =
         compile(R"(camera { location <0, -7, 2.5>  look_at <0, 0, 0.6>  sky <0, 0, 1>  angle 50 }

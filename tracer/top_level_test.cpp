@@ -96,6 +96,7 @@ struct Result {
     uint64_t expansionsAfter = 0;  // made while the rays were fired through the top level
     uint64_t expansions = 0;       // made in all
     size_t interiors = 0;          // hits whose interior is a paint node's (transparency)
+    size_t painted = 0;            // hits with a point in their paint node's frame (patterns)
     bool built = false;
 };
 
@@ -148,6 +149,7 @@ Result compareRays(const std::string& text, const std::vector<Vec3>& o, const st
         EXPECT_EQ(ha.interior, hb.interior) << "ray " << i;
         out.interiors += ha.interior != 0;
         if (ha.painted) {
+            ++out.painted;
             EXPECT_EQ(ha.paintPoint, hb.paintPoint) << "ray " << i;
         }
     }
@@ -192,6 +194,52 @@ S if(n > 0, 2, 1)
     EXPECT_GT(r.expansions, 0u);
     EXPECT_GT(r.hits, 200u);
     EXPECT_GT(r.interiors, 100u);
+    EXPECT_FALSE(r.built);
+}
+
+// A pigment pattern needs the hit point in its paint node's frame. Instances with such
+// paint nodes inside are expanded, each surface keeping the inverse matrices from the
+// S-node to its paint node, and give the walk's points bit for bit, whatever the
+// transformations between them.
+TEST(TopLevel, PatternsPaintedInsideExpandedInstancesGetTheWalksPoints) {
+    const Result r = compareWithGraphWalk(R"(
+material marble { pigment { marble turbulence 0.5 scale 0.3 } }
+material stripes { pigment { gradient x color_map { [0 color <1, 0, 0>] [1 color <0, 0, 1>] } } }
+{n = 3} M
+M if(n > 0, 2, 1)
+1: M -> paint(marble) cube ∪ move(0, 0, 1.2) paint(stripes) rotz(30) uscale(0.5) sphere
+2: M -> {n = n - 1} (move(-0.7, 0, 0) uscale(0.45) M ∪ move(0.7, 0, 0) rotx(20) uscale(0.45) M ∪
+                     move(0, 0.7, 0) paint(stripes) scale(0.4, 0.5, 0.45) M)
+)",
+                                          2000, 1.2);
+    EXPECT_GT(r.expansions, 0u);
+    EXPECT_GT(r.hits, 200u);
+    EXPECT_GT(r.painted, 200u);
+    EXPECT_FALSE(r.built);
+}
+
+// A top level holds no paint node that records its frame or instance: its Instance and
+// Deferred nodes would not pass it on to the surfaces below them, so it is the walk's (a
+// marble Menger sponge, painted at the axiom: its copies of the expanded cubes are walked).
+TEST(TopLevel, APaintNodeThatRecordsItsFrameAboveTheCopiesLeavesThemToTheWalk) {
+    std::string text = R"(
+material marble { pigment { marble turbulence 0.5 scale 0.3 } }
+paint(marble) {n = 3} M
+M if(n > 0, 2, 1)
+1: M -> cube
+2: M -> {n = n - 1} ()";
+    const char* sep = "";
+    for (int x = -1; x <= 1; ++x)  // (the 20 cubes of the Menger sponge's rule)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z) {
+                if ((x == 0) + (y == 0) + (z == 0) >= 2) continue;
+                text += sep + ("move(" + std::to_string(x) + "*2/3, " + std::to_string(y) +
+                               "*2/3, " + std::to_string(z) + "*2/3) uscale(1/3) M");
+                sep = " ∪ ";
+            }
+    const Result r = compareWithGraphWalk(text + ")\n", 2000, 1.0);
+    EXPECT_GT(r.hits, 200u);
+    EXPECT_GT(r.painted, 200u);
     EXPECT_FALSE(r.built);
 }
 

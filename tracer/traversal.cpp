@@ -315,7 +315,10 @@ void Tracer::resetWalk() {
 bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
     if (g_.axiom == kNone) return false;
     const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
-    if (expansion_) expansion_->scratch().interiors.clear();
+    if (expansion_) {
+        expansion_->scratch().interiors.clear();
+        expansion_->scratch().points.clear();
+    }
     const Ctx c{rootFrame_.data(), kRootPath, 0, 0, 0};
     const LocalRay r{origin, dir};
     Hit hit;
@@ -345,8 +348,11 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     out.painted = false;
     out.interior = 0;
     if (hit.paint & UnrolledInstance::kScratchPaint) {  // painted inside an expansion
-        out.interior =
-            expansion_->scratch().interiors[hit.paint & ~UnrolledInstance::kScratchPaint];
+        const UnrolledInstance::Scratch& s = expansion_->scratch();
+        const uint32_t k = hit.paint & ~UnrolledInstance::kScratchPaint;
+        out.interior = s.interiors[k];
+        out.painted = scene_.paintFrames[hit.material] & TraceScene::kPaintPoint;
+        out.paintPoint = s.points[k];
     } else if (hit.paint != 0) {
         // (painted: the point is in the paint node's frame, for the material's patterns; a
         // material that records only its interior has none, here or in an expansion)

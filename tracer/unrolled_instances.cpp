@@ -687,15 +687,26 @@ class Unroller {
         return e.x * e.y + e.y * e.z + e.z * e.x;
     }
 
-    // A paint node: the surfaces below it record its instance where the material needs
-    // only that (transparency's interiors: the node and the choices that lead to it); a
-    // pattern's frame is the graph walk's to record.
+    // A paint node whose material needs its instance (transparency's interiors: the node
+    // and the choices that lead to it) or its frame (a pigment pattern: the inverse
+    // matrices on the way to it, all of pending_) is recorded for the surfaces below it.
+    // The map from the world into its frame (a normal pattern) is the graph walk's, and so
+    // is every such paint node of a top level (its Instance and Deferred nodes would not
+    // pass it on).
     void paintNode(NodeId n, PathState& s) {
         s.paint = 0;
         const uint32_t m = s.material;
         if (!scene_.paintFrameOf(m)) return;
-        if (scene_.paintFrames[m] != TraceScene::kPaintInterior) throw TooLarge{};
-        out_.paints_.push_back({n, static_cast<uint32_t>(choices_.size())});
+        const uint8_t marks = scene_.paintFrames[m];
+        if (cuts_ || (marks & TraceScene::kPaintMap)) throw TooLarge{};
+        UnrolledInstance::PaintAt at{n, static_cast<uint32_t>(choices_.size())};
+        if (marks & TraceScene::kPaintPoint) {
+            at.point = true;
+            at.firstMatrix = static_cast<uint32_t>(out_.matrixRefs_.size());
+            at.matrices = static_cast<uint32_t>(pending_.size());
+            out_.matrixRefs_.insert(out_.matrixRefs_.end(), pending_.begin(), pending_.end());
+        }
+        out_.paints_.push_back(at);
         s.paint = static_cast<uint32_t>(out_.paints_.size());
     }
 
@@ -833,7 +844,9 @@ uint64_t UnrolledInstance::digest() const {
     // (only where there are some: the digests of other expansions stay what they were)
     if (!paints_.empty()) {
         d.add(paints_.size());
-        for (const PaintAt& p : paints_) d.add(p.node), d.add(p.prefix);
+        for (const PaintAt& p : paints_)
+            d.add(p.node), d.add(p.prefix), d.add(p.firstMatrix), d.add(p.matrices),
+                d.add(static_cast<uint32_t>(p.point));
         for (const Node& n : nodes_) d.add(n.paintAt);
     }
     if (!deferred_.empty()) d.add(deferred_.size());
@@ -888,7 +901,12 @@ bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
     // (instances referred to need theirs too: no resizing while a link's ray is in use)
     if (s.linked.size() < linkSlots_) s.linked.resize(linkSlots_);
     if (!firstAt(root_, r, tmin, tmax, hit, use, anyHit, s)) return false;
-    if (hit.paint & kNodePaint) resolvePaint(hit.paint, use.path, s);
+    if (hit.paint & kNodePaint) {  // (a shadow ray's hit is only its existence)
+        if (anyHit)
+            hit.paint = 0;
+        else
+            resolvePaint(hit.paint, use.path, r, hit.t, s);
+    }
     return true;
 }
 
@@ -900,8 +918,9 @@ size_t UnrolledInstance::spans(const LocalRay& r, double tmin, double tmax,
     const size_t count = spansAt(root_, r, tmin, tmax, spans, use, s);
     if (!paints_.empty())
         for (size_t k = spans.size() - count; k < spans.size(); ++k) {
-            if (spans[k].in.paint & kNodePaint) resolvePaint(spans[k].in.paint, use.path, s);
-            if (spans[k].out.paint & kNodePaint) resolvePaint(spans[k].out.paint, use.path, s);
+            Span& sp = spans[k];
+            if (sp.in.paint & kNodePaint) resolvePaint(sp.in.paint, use.path, r, sp.in.t, s);
+            if (sp.out.paint & kNodePaint) resolvePaint(sp.out.paint, use.path, r, sp.out.t, s);
         }
     return count;
 }
@@ -916,9 +935,11 @@ uint32_t UnrolledInstance::paintOf(const Node& node, const Use& use) const {
 }
 
 // A surface's paint handle kNodePaint | n becomes its interior (the paint node and the
-// instance path that reached it, as the graph walk records them), kept in the scratch
-// space till the end of the ray's walk (kScratchPaint).
-void UnrolledInstance::resolvePaint(uint32_t& paint, uint64_t path, Scratch& s) const {
+// instance path that reached it) and its point at t in the paint node's frame (the ray r,
+// in the S-node's frame, through the same matrices), as the graph walk records them, kept
+// in the scratch space till the end of the ray's walk (kScratchPaint).
+void UnrolledInstance::resolvePaint(uint32_t& paint, uint64_t path, const LocalRay& r, double t,
+                                    Scratch& s) const {
     const Node& node = nodes_[paint & ~kNodePaint];
     const PaintAt& at = paints_[node.paintAt];
     for (uint32_t k = 0; k < at.prefix; ++k) {
@@ -926,6 +947,13 @@ void UnrolledInstance::resolvePaint(uint32_t& paint, uint64_t path, Scratch& s) 
         path = (c & kRuleBit) ? pathRuleInline(path, c & ~kRuleBit) : pathChildInline(path, c);
     }
     s.interiors.push_back(pathChild(path, 0x80000000u | at.node) | 1);
+    Vec3 point{};
+    if (at.point) {
+        const LocalRay p =
+            mapRay(matrices_.data(), matrixRefs_.data() + at.firstMatrix, at.matrices, r);
+        point = p.o + p.d * t;
+    }
+    s.points.push_back(point);
     paint = kScratchPaint | static_cast<uint32_t>(s.interiors.size() - 1);
 }
 

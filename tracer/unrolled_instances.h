@@ -82,8 +82,9 @@ class UnrolledInstance {
     };
 
     // The paint handle of a surface painted inside an expansion (Hit::paint,
-    // Boundary::paint): its interior is Scratch::interiors[paint & ~kScratchPaint], kept
-    // till the end of the ray's walk; the walk's own handles are small numbers.
+    // Boundary::paint): its interior is Scratch::interiors[paint & ~kScratchPaint] and
+    // its point in the paint node's frame Scratch::points[...], kept till the end of the
+    // ray's walk; the walk's own handles are small numbers.
     static constexpr uint32_t kScratchPaint = 1u << 31;
 
     // First hits through nested unions: the operands of a union and of the unions nested in
@@ -117,10 +118,14 @@ class UnrolledInstance {
     };
 
     // A paint node whose instance the surfaces below it record (Node::paintAt): the node,
-    // and how many of a surface's choices lead to it.
+    // how many of a surface's choices lead to it, and, where its material has a pigment
+    // pattern, the inverse matrices on the way to it from the instance's S-node
+    // (matrixRefs_[firstMatrix..]), which map a ray into the paint node's frame.
     struct PaintAt {
         NodeId node;
         uint32_t prefix;
+        uint32_t firstMatrix = 0, matrices = 0;
+        bool point = false;
     };
 
     // A Deferred node's S-node instance: the S-node, its depth (Semantics::selectDepth) and
@@ -157,6 +162,7 @@ class UnrolledInstance {
         };
         std::vector<Linked> linked;
         std::vector<uint64_t> interiors;  // of the surfaces painted inside (kScratchPaint)
+        std::vector<Vec3> points;         // and their points in the paint node's frame
         uint64_t stamp = 0;
         uint64_t visits = 0;
     };
@@ -250,7 +256,8 @@ class UnrolledInstance {
     Vec3 leave(const Node& node, Vec3 normal) const;
     uint64_t keyOf(const Node& node, uint64_t path) const;
     uint32_t paintOf(const Node& node, const Use& use) const;
-    void resolvePaint(uint32_t& paint, uint64_t path, Scratch& s) const;
+    void resolvePaint(uint32_t& paint, uint64_t path, const LocalRay& r, double t,
+                      Scratch& s) const;
 
     std::vector<Node> nodes_;
     std::vector<uint32_t> children_;
