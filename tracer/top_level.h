@@ -19,9 +19,10 @@
 //    instances of that (module, depth) without refusing one as too large; elsewhere it
 //    expands in place. Copies are shared by their instance key (and depth).
 //  - When it is refused (then tried with deferred cuts, below): an operator other than a
-//    union above the cuts, a paint node whose pattern needs its frame, a level where the
-//    cache stopped expanding, more than half as many instances as copies (a terrain's
-//    patches: every instance unique), more than `maxBytes` in all (top and instances),
+//    union above the cuts, a paint node whose material needs its frame or its instance
+//    (a pattern, transparency: Instance and Deferred nodes would not pass it on), a level
+//    where the cache stopped expanding, more than half as many instances as copies (a
+//    terrain's patches: every instance unique), more than `maxBytes` in all (top and instances),
 //    more node visits above the cuts than kMaxVisits and a few per copy met (see below),
 //    an instance whose deepest S-node passes max_depth, or a run-time error (the walk
 //    raises it where a ray meets it). Not tried again with deferred cuts: a dry run refused

@@ -26,9 +26,13 @@
 //  - Materials and tie-break keys depend on where an instance is used, not on what it
 //    is: a primitive without a paint above it inside the instance takes the caller's
 //    material (and the frame of the caller's paint node, for patterns), and each hit's
-//    instance path is replayed from the S-node's path. An instance with a paint node
-//    whose material has a pattern inside is not expanded: the graph walk records that
-//    node's frame.
+//    instance path is replayed from the S-node's path. A paint node inside an instance
+//    whose material needs its instance (transparency's interiors) or its frame (a
+//    pigment pattern) is kept for the surfaces below it (paints_: the node, the choices
+//    that lead to it, the inverse matrices on the way), and a hit there gets its interior
+//    and its point in that frame as the walk would give them (resolvePaint). One whose
+//    normal pattern needs the map from the world into that frame is not expanded: the
+//    graph walk records it, and so does a top level's every such paint node.
 //  - Two levels (top_level.h): an expansion of the whole graph from the axiom may stop at
 //    S-node instances and refer to expanded instances of their own instead (a node of
 //    kind Instance: the S-node's matrices and material as for a primitive, and its
@@ -177,8 +181,9 @@ class UnrolledInstance {
 
     // Expands the S-node instance (select, frame, path) at `depth`: nullptr when the
     // expansion takes more than `maxVisits` node visits or meets a paint node whose
-    // pattern needs the node's frame (the graph walk records it). Throws RuntimeError
-    // (without this S-node in its module path) when unrolling meets a run-time error.
+    // normal pattern needs the map into the node's frame (the graph walk records it).
+    // Throws RuntimeError (without this S-node in its module path) when unrolling meets a
+    // run-time error.
     static std::unique_ptr<UnrolledInstance> expand(const TraceScene& scene, NodeId select,
                                                     uint32_t depth, const double* frame,
                                                     uint64_t path, uint64_t maxVisits);
