@@ -252,6 +252,25 @@ TEST(TopLevel, SierpinskiCopiesShareTheirInstanceAndHitTheWalksSurfaces) {
     EXPECT_GT(r.hits, 300u);
 }
 
+// Copies of an instance with glass or a pigment pattern painted inside it: the top level
+// refers to the instance, and each surface painted there gets the interior and the point
+// the walk gives, from the copy's instance path and its ray in the copy's frame.
+TEST(TopLevel, CopiesOfInstancesPaintedInsideGetTheWalksInteriorsAndPoints) {
+    for (const char* material : {"pigment { color rgbf <0.8, 1, 0.9, 0.85> } interior { ior 1.4 }",
+                                 "pigment { marble turbulence 0.4 scale 0.2 }"}) {
+        std::string text = testing::sierpinski(5);
+        const size_t leaf = text.find("tetrahedron");
+        ASSERT_NE(leaf, std::string::npos);
+        text.insert(leaf, "paint(m) ");
+        text = "material m { " + std::string(material) + " }\n" + text;
+        const Result r = compareWithGraphWalk(text, 3000, 1.0, 256u << 10);
+        ASSERT_TRUE(r.built) << material;
+        EXPECT_GE(r.copies, 16u);
+        EXPECT_GT(r.hits, 300u);
+        EXPECT_GT(r.interiors + r.painted, 300u) << material;
+    }
+}
+
 TEST(TopLevel, CopiesBeyondTheVisitsOfAFewHundredAreNotRefused) {
     // (only small instances are expanded, those of a deep level: thousands of copies, whose
     // top level takes more than kMaxVisits visits above them)

@@ -1080,18 +1080,28 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
 // An Instance node's instance, the ray in its S-node's frame: first() without its clip to
 // the instance's box (this node's box, which holds it, has been met, and boxes only cull;
 // first() on the top level has sized s.linked for the instances too), and straight into
-// the root's hierarchy where firstAt(root_) would only walk it. (Out of line: firstAt, the
-// primitives' walk too, stays as small as it was.)
+// the root's hierarchy where firstAt(root_) would only walk it; a surface painted inside it
+// resolved as first() resolves it. (Out of line: firstAt, the primitives' walk too, stays
+// as small as it was.)
 [[gnu::noinline]] bool UnrolledInstance::firstInInstance(const Reference& ref, const LocalRay& r,
                                                          double tmin, double& tmax, Hit& hit,
                                                          const Use& inside, bool anyHit,
                                                          Scratch& s) const {
     const UnrolledInstance& x = *ref.instance;
+    bool found;
     if (x.rootBvh_ != kNone) {
         ++s.visits;  // (as firstAt(root_) counts it)
-        return x.firstBvh(x.rootBvh_, r, tmin, tmax, hit, inside, anyHit, s);
+        found = x.firstBvh(x.rootBvh_, r, tmin, tmax, hit, inside, anyHit, s);
+    } else {
+        found = x.root_ != kNone && x.firstAt(x.root_, r, tmin, tmax, hit, inside, anyHit, s);
     }
-    return x.root_ != kNone && x.firstAt(x.root_, r, tmin, tmax, hit, inside, anyHit, s);
+    if (found && (hit.paint & kNodePaint)) {  // (a shadow ray's hit is only its existence)
+        if (anyHit)
+            hit.paint = 0;
+        else
+            x.resolvePaint(hit.paint, inside.path, r, hit.t, s);
+    }
+    return found;
 }
 
 // A Deferred node's instance, the ray in its S-node's frame: the walker's (the tracer's).
