@@ -314,7 +314,7 @@ void Tracer::resetWalk() {
 
 bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax, SurfaceHit& out) {
     if (g_.axiom == kNone) return false;
-    const UnrollCache::Pin pin(expansion_.get());  // the instances met stay valid till here
+    const UnrollCache::Pin pin(expansion_.get());     // the instances met stay valid till here
     if (expansion_ && !scene_.paintFrames.empty()) {  // (surfaces painted in expansions)
         expansion_->scratch().interiors.clear();
         expansion_->scratch().points.clear();
