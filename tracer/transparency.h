@@ -44,9 +44,17 @@
 #include <cstdint>
 #include <optional>
 
+#include "eval.h"
 #include "graph.h"
 
 namespace pcsg::tracer {
+
+// The interior of a paint node instance, the object a surface below it belongs to: paint
+// node `n` reached by instance path `path` (never 0, the default interior). The graph walk
+// and the expanded instances record the same number.
+inline uint64_t paintInteriorOf(uint64_t path, NodeId n) {
+    return pathChild(path, 0x80000000u | n) | 1;
+}
 
 // One object's interior: which object (the paint node instance, SurfaceHit::interior; 0:
 // the default interior of surfaces under no paint node) and the material whose ior and

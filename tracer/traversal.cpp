@@ -345,18 +345,16 @@ bool Tracer::walk(const Vec3& origin, const Vec3& dir, double tmin, double tmax,
     out.normal = hit.normal;
     out.material = hit.material;
     out.path = hit.key;
-    out.painted = false;
+    // (painted: the point is in the paint node's frame, for the material's patterns; a
+    // material that records only its interior has none, here or in an expansion)
+    out.painted = hit.paint != 0 && (scene_.paintFrames[hit.material] & TraceScene::kPaintPoint);
     out.interior = 0;
     if (hit.paint & UnrolledInstance::kScratchPaint) {  // painted inside an expansion
         const UnrolledInstance::Scratch& s = expansion_->scratch();
         const uint32_t k = hit.paint & ~UnrolledInstance::kScratchPaint;
         out.interior = s.interiors[k];
-        out.painted = scene_.paintFrames[hit.material] & TraceScene::kPaintPoint;
         out.paintPoint = s.points[k];
     } else if (hit.paint != 0) {
-        // (painted: the point is in the paint node's frame, for the material's patterns; a
-        // material that records only its interior has none, here or in an expansion)
-        out.painted = scene_.paintFrames[hit.material] & TraceScene::kPaintPoint;
         out.interior = paintInteriors_[hit.paint - 1];
         const LocalRay& p = paintRays_[hit.paint - 1];
         out.paintPoint = p.o + p.d * hit.t;
@@ -443,7 +441,7 @@ template <bool kOperands, class Below, class Unrolled, class TransformBack>
     if (kind == NodeKind::Paint && !anyHit_ && scene_.paintFrameOf(st.state.material)) {
         paintRays_.push_back(r);  // a paint node keeps the frame: r is the ray in its frame
         // and its instance: the node and its instance path (never 0, the default interior)
-        paintInteriors_.push_back(pathChild(c.path, 0x80000000u | n) | 1);
+        paintInteriors_.push_back(paintInteriorOf(c.path, n));
         st.state.paint = static_cast<uint32_t>(paintRays_.size());
         if (scene_.paintMaps) paintMaps_.push_back(paintMapHere(st.state.material));
     }

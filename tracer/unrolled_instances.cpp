@@ -16,6 +16,7 @@
 #include "flat_index.h"
 #include "map_ray.h"
 #include "outward_float.h"
+#include "transparency.h"
 #include "traversal.h"
 
 namespace pcsg::tracer {
@@ -32,8 +33,8 @@ bool isUnion(const UnrolledInstance::Node& n) {
 // interior resolvePaint() finds (the walk's own handles are small numbers).
 constexpr uint32_t kNodePaint = 1u << 30;
 
-// The expansion took more visits than its depth promised, or met a paint node whose
-// pattern needs the node's frame: leave it to the graph walk.
+// The expansion took more visits than its depth promised, or met a paint node it leaves
+// to the graph walk (paintNode): leave it all to the walk.
 struct TooLarge {};
 
 }  // namespace
@@ -884,13 +885,19 @@ const LocalRay& UnrolledInstance::linkedRay(uint32_t l, const LocalRay& r, uint6
     return e.ray;
 }
 
-// (the mixers inline: a hit replays a dozen choices)
-uint64_t UnrolledInstance::keyOf(const Node& node, uint64_t path) const {
-    for (uint32_t k = 0; k < node.choices; ++k) {
+// The instance path after the first `count` of the node's choices, from `path` at the
+// S-node. (The mixers inline: a hit replays a dozen choices.)
+inline uint64_t UnrolledInstance::replayChoices(const Node& node, uint64_t path,
+                                                uint32_t count) const {
+    for (uint32_t k = 0; k < count; ++k) {
         const uint32_t c = choices_[node.firstChoice + k];
         path = (c & kRuleBit) ? pathRuleInline(path, c & ~kRuleBit) : pathChildInline(path, c);
     }
     return path;
+}
+
+uint64_t UnrolledInstance::keyOf(const Node& node, uint64_t path) const {
+    return replayChoices(node, path, node.choices);
 }
 
 bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& hit, const Use& use,
@@ -901,12 +908,7 @@ bool UnrolledInstance::first(const LocalRay& r, double tmin, double& tmax, Hit& 
     // (instances referred to need theirs too: no resizing while a link's ray is in use)
     if (s.linked.size() < linkSlots_) s.linked.resize(linkSlots_);
     if (!firstAt(root_, r, tmin, tmax, hit, use, anyHit, s)) return false;
-    if (hit.paint & kNodePaint) {  // (a shadow ray's hit is only its existence)
-        if (anyHit)
-            hit.paint = 0;
-        else
-            resolvePaint(hit.paint, use.path, r, hit.t, s);
-    }
+    settlePaint(hit, use.path, r, anyHit, s);
     return true;
 }
 
@@ -934,6 +936,18 @@ uint32_t UnrolledInstance::paintOf(const Node& node, const Use& use) const {
     return kNodePaint | static_cast<uint32_t>(&node - nodes_.data());
 }
 
+// The hit of a search of this instance (from the instance path `path` at its S-node, the
+// ray r in the S-node's frame): a surface painted inside it resolved (resolvePaint), or,
+// for a shadow ray, whose hit is only its existence, no paint at all.
+void UnrolledInstance::settlePaint(Hit& hit, uint64_t path, const LocalRay& r, bool anyHit,
+                                   Scratch& s) const {
+    if (!(hit.paint & kNodePaint)) return;
+    if (anyHit)
+        hit.paint = 0;
+    else
+        resolvePaint(hit.paint, path, r, hit.t, s);
+}
+
 // A surface's paint handle kNodePaint | n becomes its interior (the paint node and the
 // instance path that reached it) and its point at t in the paint node's frame (the ray r,
 // in the S-node's frame, through the same matrices), as the graph walk records them, kept
@@ -942,11 +956,7 @@ void UnrolledInstance::resolvePaint(uint32_t& paint, uint64_t path, const LocalR
                                     Scratch& s) const {
     const Node& node = nodes_[paint & ~kNodePaint];
     const PaintAt& at = paints_[node.paintAt];
-    for (uint32_t k = 0; k < at.prefix; ++k) {
-        const uint32_t c = choices_[node.firstChoice + k];
-        path = (c & kRuleBit) ? pathRuleInline(path, c & ~kRuleBit) : pathChildInline(path, c);
-    }
-    s.interiors.push_back(pathChild(path, 0x80000000u | at.node) | 1);
+    s.interiors.push_back(paintInteriorOf(replayChoices(node, path, at.prefix), at.node));
     Vec3 point{};
     if (at.point) {
         const LocalRay p =
@@ -1088,19 +1098,16 @@ bool UnrolledInstance::firstAt(uint32_t n, const LocalRay& r, double tmin, doubl
                                                          const Use& inside, bool anyHit,
                                                          Scratch& s) const {
     const UnrolledInstance& x = *ref.instance;
-    bool found;
-    if (x.rootBvh_ != kNone) {
-        ++s.visits;  // (as firstAt(root_) counts it)
-        found = x.firstBvh(x.rootBvh_, r, tmin, tmax, hit, inside, anyHit, s);
-    } else {
-        found = x.root_ != kNone && x.firstAt(x.root_, r, tmin, tmax, hit, inside, anyHit, s);
-    }
-    if (found && (hit.paint & kNodePaint)) {  // (a shadow ray's hit is only its existence)
-        if (anyHit)
-            hit.paint = 0;
-        else
-            x.resolvePaint(hit.paint, inside.path, r, hit.t, s);
-    }
+    const auto search = [&] {
+        if (x.rootBvh_ != kNone) {
+            ++s.visits;  // (as firstAt(root_) counts it)
+            return x.firstBvh(x.rootBvh_, r, tmin, tmax, hit, inside, anyHit, s);
+        }
+        return x.root_ != kNone && x.firstAt(x.root_, r, tmin, tmax, hit, inside, anyHit, s);
+    };
+    if (x.paints_.empty()) return search();  // (nothing painted inside: tail calls)
+    const bool found = search();
+    if (found) x.settlePaint(hit, inside.path, r, anyHit, s);
     return found;
 }
 

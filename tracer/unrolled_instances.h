@@ -78,9 +78,9 @@ class UnrolledInstance {
         uint32_t first = 0, count = 0;           // operators: children; primitives: args
         uint32_t firstChoice = 0, choices = 0;   // the path from the S-node (hit sources)
         uint32_t bvh = kNone;                    // unions: the root of their first-hit BVH
-        // Surfaces painted inside the instance, in scenes whose paint nodes record their
-        // instance (transparency's interiors): the paint node, paints_[paintAt] (kNone:
-        // none, or the material is the caller's).
+        // Surfaces painted inside the instance by a paint node that records its instance
+        // (transparency's interiors) or its frame (a pigment pattern): that paint node,
+        // paints_[paintAt] (kNone: none, or the material is the caller's).
         uint32_t paintAt = kNone;
         Box box;  // what the node holds, in the frame it is entered from, padded
     };
@@ -259,8 +259,10 @@ class UnrolledInstance {
                   const Use& use, bool anyHit, Scratch& s) const;
     LocalRay enter(const Node& node, const LocalRay& r) const;
     Vec3 leave(const Node& node, Vec3 normal) const;
+    uint64_t replayChoices(const Node& node, uint64_t path, uint32_t count) const;
     uint64_t keyOf(const Node& node, uint64_t path) const;
     uint32_t paintOf(const Node& node, const Use& use) const;
+    void settlePaint(Hit& hit, uint64_t path, const LocalRay& r, bool anyHit, Scratch& s) const;
     void resolvePaint(uint32_t& paint, uint64_t path, const LocalRay& r, double t,
                       Scratch& s) const;
 
